@@ -1,0 +1,95 @@
+#include "accel/box.h"
+
+namespace ember {
+
+Box::Box(const Vec3& center, const Vec3& size, const glm::mat3& rotation)
+    : center_(center), half_(0.5f * size), rotation_(rotation) {}
+
+Bounds Box::bounds() const {
+  Bounds b;
+  for (int i = 0; i < 8; ++i) {
+    const Vec3 corner((i & 1) ? half_.x : -half_.x, (i & 2) ? half_.y : -half_.y,
+                      (i & 4) ? half_.z : -half_.z);
+    b.extend(center_ + rotation_ * corner);
+  }
+  return b;
+}
+
+// UV of a point on face `axis` (0, 1, 2 = x, y, z) from the other two local coordinates.
+static Vec2 faceUv(const glm::dvec3& local, const Vec3& half, int axis) {
+  const int a = (axis + 1) % 3, b = (axis + 2) % 3;
+  return Vec2(float(0.5 + 0.5 * local[a] / half[a]), float(0.5 + 0.5 * local[b] / half[b]));
+}
+
+bool Box::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const {
+  const glm::dmat3 toLocal = glm::transpose(glm::dmat3(rotation_));
+  const glm::dvec3 o = toLocal * (glm::dvec3(ray.origin) - glm::dvec3(center_));
+  const glm::dvec3 d = toLocal * glm::dvec3(ray.dir);
+  double tNear = -kInfinity, tFar = kInfinity;
+  int nearAxis = -1, farAxis = -1;
+  for (int i = 0; i < 3; ++i) {
+    if (d[i] == 0.0) {
+      if (std::abs(o[i]) > half_[i]) return false;
+      continue;
+    }
+    double t0 = (-half_[i] - o[i]) / d[i];
+    double t1 = (half_[i] - o[i]) / d[i];
+    if (t0 > t1) std::swap(t0, t1);
+    if (t0 > tNear) {
+      tNear = t0;
+      nearAxis = i;
+    }
+    if (t1 < tFar) {
+      tFar = t1;
+      farAxis = i;
+    }
+  }
+  if (tNear > tFar) return false;
+  double t;
+  int axis;
+  if (tNear > tMin && tNear < tMax) {
+    t = tNear;
+    axis = nearAxis;
+  } else if (tFar > tMin && tFar < tMax) {
+    t = tFar;  // the ray starts inside the box
+    axis = farAxis;
+  } else {
+    return false;
+  }
+  if (axis < 0) return false;
+  const glm::dvec3 local = o + t * d;
+  Vec3 nLocal(0.0f);
+  nLocal[axis] = local[axis] > 0.0 ? 1.0f : -1.0f;
+  hit.t = float(t);
+  hit.ng = rotation_ * nLocal;
+  hit.uv = faceUv(local, half_, axis);
+  return true;
+}
+
+float Box::area() const {
+  return 8.0f * (half_.x * half_.y + half_.y * half_.z + half_.z * half_.x);
+}
+
+ShapeSample Box::sampleArea(Vec2 u) const {
+  // Choose one of the six faces by area, then a uniform point on it.
+  const float faceArea[3] = {4.0f * half_.y * half_.z, 4.0f * half_.z * half_.x,
+                             4.0f * half_.x * half_.y};
+  float pick = u.x * 2.0f * (faceArea[0] + faceArea[1] + faceArea[2]);
+  int face = 0;
+  while (face < 5 && pick >= faceArea[face / 2]) {
+    pick -= faceArea[face / 2];
+    ++face;
+  }
+  const int axis = face / 2;
+  const float sign = (face % 2) ? 1.0f : -1.0f;
+  const float ua = std::min(pick / faceArea[axis], 1.0f);
+  const int a = (axis + 1) % 3, b = (axis + 2) % 3;
+  Vec3 local(0.0f), nLocal(0.0f);
+  local[axis] = sign * half_[axis];
+  local[a] = (2.0f * ua - 1.0f) * half_[a];
+  local[b] = (2.0f * u.y - 1.0f) * half_[b];
+  nLocal[axis] = sign;
+  return {center_ + rotation_ * local, rotation_ * nLocal};
+}
+
+}  // namespace ember

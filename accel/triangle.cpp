@@ -1,0 +1,100 @@
+#include "accel/triangle.h"
+
+#include "renderer/sampling.h"
+
+namespace ember {
+
+bool intersectTriangle(const Ray& ray, const Vec3& v0, const Vec3& v1, const Vec3& v2, float tMin,
+                       float tMax, float& t, float& b1, float& b2) {
+  const glm::dvec3 e1 = glm::dvec3(v1) - glm::dvec3(v0);
+  const glm::dvec3 e2 = glm::dvec3(v2) - glm::dvec3(v0);
+  const glm::dvec3 d(ray.dir);
+  const glm::dvec3 pvec = glm::cross(d, e2);
+  const double det = glm::dot(e1, pvec);
+  if (det == 0.0) return false;
+  const double invDet = 1.0 / det;
+  const glm::dvec3 tvec = glm::dvec3(ray.origin) - glm::dvec3(v0);
+  const double u = glm::dot(tvec, pvec) * invDet;
+  if (u < 0.0 || u > 1.0) return false;
+  const glm::dvec3 qvec = glm::cross(tvec, e1);
+  const double v = glm::dot(d, qvec) * invDet;
+  if (v < 0.0 || u + v > 1.0) return false;
+  const double tt = glm::dot(e2, qvec) * invDet;
+  if (tt <= tMin || tt >= tMax) return false;
+  t = float(tt);
+  b1 = float(u);
+  b2 = float(v);
+  return true;
+}
+
+static Vec3 frontNormal(const Vec3& v0, const Vec3& v1, const Vec3& v2) {
+  return glm::normalize(glm::cross(v1 - v0, v2 - v0));
+}
+static float triangleArea(const Vec3& v0, const Vec3& v1, const Vec3& v2) {
+  return 0.5f * glm::length(glm::cross(v1 - v0, v2 - v0));
+}
+
+Triangle::Triangle(const std::array<Vec3, 3>& v, const std::array<Vec2, 3>& uv)
+    : v_(v), uv_(uv), normal_(frontNormal(v[0], v[1], v[2])), area_(triangleArea(v[0], v[1], v[2])) {}
+
+Bounds Triangle::bounds() const {
+  Bounds b;
+  for (const Vec3& p : v_) b.extend(p);
+  return b;
+}
+
+bool Triangle::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const {
+  float t, b1, b2;
+  if (!intersectTriangle(ray, v_[0], v_[1], v_[2], tMin, tMax, t, b1, b2)) return false;
+  hit.t = t;
+  hit.ng = normal_;
+  hit.uv = (1.0f - b1 - b2) * uv_[0] + b1 * uv_[1] + b2 * uv_[2];
+  return true;
+}
+
+ShapeSample Triangle::sampleArea(Vec2 u) const {
+  const Vec2 b = sampleUniformTriangle(u);
+  return {b.x * v_[0] + b.y * v_[1] + (1.0f - b.x - b.y) * v_[2], normal_};
+}
+
+Quad::Quad(const std::array<Vec3, 4>& v, const std::array<Vec2, 4>& uv)
+    : v_(v),
+      uv_(uv),
+      normal_(frontNormal(v[0], v[1], v[2])),
+      area0_(triangleArea(v[0], v[1], v[2])),
+      area1_(triangleArea(v[0], v[2], v[3])) {}
+
+Bounds Quad::bounds() const {
+  Bounds b;
+  for (const Vec3& p : v_) b.extend(p);
+  return b;
+}
+
+bool Quad::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const {
+  float t, b1, b2;
+  if (intersectTriangle(ray, v_[0], v_[1], v_[2], tMin, tMax, t, b1, b2)) {
+    hit.uv = (1.0f - b1 - b2) * uv_[0] + b1 * uv_[1] + b2 * uv_[2];
+  } else if (intersectTriangle(ray, v_[0], v_[2], v_[3], tMin, tMax, t, b1, b2)) {
+    hit.uv = (1.0f - b1 - b2) * uv_[0] + b1 * uv_[2] + b2 * uv_[3];
+  } else {
+    return false;
+  }
+  hit.t = t;
+  hit.ng = normal_;
+  return true;
+}
+
+ShapeSample Quad::sampleArea(Vec2 u) const {
+  // Pick a triangle by area, then reuse the remainder of u.x.
+  const float total = area0_ + area1_;
+  const float pick = u.x * total;
+  const bool first = pick < area0_;
+  const float ux = first ? pick / area0_ : (pick - area0_) / area1_;
+  const Vec2 b = sampleUniformTriangle(Vec2(std::min(ux, 0.99999994f), u.y));
+  const Vec3& a = v_[0];
+  const Vec3& p1 = first ? v_[1] : v_[2];
+  const Vec3& p2 = first ? v_[2] : v_[3];
+  return {b.x * a + b.y * p1 + (1.0f - b.x - b.y) * p2, normal_};
+}
+
+}  // namespace ember

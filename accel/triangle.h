@@ -1,0 +1,51 @@
+// Flat triangle and planar quad (two triangles (v0,v1,v2), (v0,v2,v3), as in ../shared/refs).
+// The front normal is normalize(cross(v1 - v0, v2 - v0)). UVs are per-vertex and interpolated
+// barycentrically; defaults: triangle (0,0), (1,0), (0,1); quad (0,0), (1,0), (1,1), (0,1).
+#pragma once
+
+#include "accel/shape.h"
+
+#include <array>
+
+namespace ember {
+
+// Moller & Trumbore 1997, "Fast, Minimum Storage Ray/Triangle Intersection", in double precision.
+// On a hit, writes t and the barycentrics (b1, b2) of v1 and v2.
+bool intersectTriangle(const Ray& ray, const Vec3& v0, const Vec3& v1, const Vec3& v2, float tMin,
+                       float tMax, float& t, float& b1, float& b2);
+
+class Triangle final : public Shape {
+ public:
+  Triangle(const std::array<Vec3, 3>& v, const std::array<Vec2, 3>& uv);
+
+  std::string_view typeName() const override { return "triangle"; }
+  Bounds bounds() const override;
+  bool intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const override;
+  float area() const override { return area_; }
+  ShapeSample sampleArea(Vec2 u) const override;
+
+ private:
+  std::array<Vec3, 3> v_;
+  std::array<Vec2, 3> uv_;
+  Vec3 normal_;
+  float area_;
+};
+
+class Quad final : public Shape {
+ public:
+  Quad(const std::array<Vec3, 4>& v, const std::array<Vec2, 4>& uv);
+
+  std::string_view typeName() const override { return "quad"; }
+  Bounds bounds() const override;
+  bool intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const override;
+  float area() const override { return area0_ + area1_; }
+  ShapeSample sampleArea(Vec2 u) const override;
+
+ private:
+  std::array<Vec3, 4> v_;
+  std::array<Vec2, 4> uv_;
+  Vec3 normal_;
+  float area0_, area1_;  // of (v0,v1,v2) and (v0,v2,v3)
+};
+
+}  // namespace ember

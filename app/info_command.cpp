@@ -1,0 +1,47 @@
+#include "app/commands.h"
+
+#include "io/scene_loader.h"
+
+#include <map>
+#include <memory>
+
+namespace ember::cli {
+
+Runner addInfoCommand(CLI::App& app) {
+  auto path = std::make_shared<std::string>();
+  CLI::App* cmd = app.add_subcommand("info", "Print what a scene file loads: shapes, meshes, lights, materials, bounds");
+  cmd->add_option("scene", *path, "Scene file: Ember JSON, .gltf or .glb")->required();
+  return [path] {
+    Scene scene = loadScene(*path);
+    const size_t pointLights = scene.lights.size();
+    scene.build();
+    std::map<std::string, int> byType;
+    int emitters = 0;
+    for (const auto& s : scene.shapes) {
+      ++byType[std::string(s.shape->typeName())];
+      emitters += !isBlack(s.emission);
+    }
+    const RenderSettings& rs = scene.settings;
+    const CameraParams& c = scene.cameraParams;
+    const Bounds b = scene.bounds();
+    std::printf("scene:      %s\n", path->c_str());
+    std::printf("image:      %d x %d, %d spp, max depth %d, Russian roulette from %d, seed %llu\n", rs.width,
+                rs.height, rs.spp, rs.maxDepth, rs.rrDepth, static_cast<unsigned long long>(rs.seed));
+    std::printf("camera:     origin (%g, %g, %g) target (%g, %g, %g) fov_y %g deg\n", c.origin.x, c.origin.y,
+                c.origin.z, c.target.x, c.target.y, c.target.z, c.fovYDeg);
+    std::printf("shapes:     %zu", scene.shapes.size());
+    for (const auto& [type, n] : byType) std::printf("  %s %d", type.c_str(), n);
+    std::printf("\nmeshes:     %zu (%zu triangles)\n", scene.meshes.size(), scene.triangleCount());
+    std::printf("lights:     %zu point, %d area, %s environment\n", pointLights, emitters,
+                scene.environment() ? "1" : "no");
+    std::printf("materials:  %zu", scene.materials.size());
+    for (size_t i = 0; i < scene.materials.size(); ++i)
+      std::printf("%s %s (%s)", i ? "," : "", scene.materialNames[i].c_str(),
+                  std::string(scene.materials[i]->typeName()).c_str());
+    std::printf("\nbounds:     (%g, %g, %g) - (%g, %g, %g)\n", b.lower.x, b.lower.y, b.lower.z, b.upper.x,
+                b.upper.y, b.upper.z);
+    return 0;
+  };
+}
+
+}  // namespace ember::cli

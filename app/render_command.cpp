@@ -1,0 +1,122 @@
+#include "app/commands.h"
+
+#include "io/image_io.h"
+#include "io/input_error.h"
+#include "io/scene_loader.h"
+#include "io/tonemap.h"
+#include "renderer/path_integrator.h"
+#include "renderer/render.h"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <ctime>
+#include <filesystem>
+#include <memory>
+#include <optional>
+
+namespace ember::cli {
+
+namespace {
+
+struct RenderArgs {
+  std::string scene;
+  std::string output;
+  std::string png;
+  std::string variance;
+  std::optional<int> spp, threads, width, height, maxDepth;
+  std::optional<uint64_t> seed;
+  uint64_t firstSample = 0;
+  bool quiet = false;
+};
+
+void checkOutputPath(const std::string& path, const char* extension, const char* what) {
+  namespace fs = std::filesystem;
+  std::string ext = fs::path(path).extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (ext != extension) throw InputError(path + ": " + what + " must end in " + extension);
+  const fs::path dir = fs::path(path).parent_path();
+  if (!dir.empty() && !fs::is_directory(dir)) throw InputError(path + ": output folder " + dir.string() + " does not exist");
+}
+
+std::string isoTime() {
+  const std::time_t now = std::time(nullptr);
+  char buf[64];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  return buf;
+}
+
+int runRender(const RenderArgs& a) {
+  checkOutputPath(a.output, ".exr", "-o");
+  if (!a.png.empty()) checkOutputPath(a.png, ".png", "--png");
+  if (!a.variance.empty()) checkOutputPath(a.variance, ".exr", "--variance");
+
+  const auto loadStart = std::chrono::steady_clock::now();
+  Scene scene = loadScene(a.scene);
+  RenderSettings& s = scene.settings;
+  if (a.spp) s.spp = *a.spp;
+  if (a.seed) s.seed = *a.seed;
+  if (a.width) s.width = *a.width;
+  if (a.height) s.height = *a.height;
+  if (a.maxDepth) s.maxDepth = *a.maxDepth;
+  scene.build();
+  const double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - loadStart).count();
+
+  const PathIntegrator integrator(s.maxDepth, s.rrDepth);
+  Film film(s.width, s.height);
+  RenderOptions options;
+  options.spp = s.spp;
+  options.seed = s.seed;
+  options.threads = a.threads.value_or(0);
+  options.firstSample = a.firstSample;
+  options.progress = !a.quiet;
+  const RenderStats stats = render(scene, integrator, options, film);
+
+  const Image image = film.mean();
+  const Metadata meta{
+      {"ember:scene", a.scene},           {"ember:spp", std::to_string(s.spp)},
+      {"ember:seed", std::to_string(s.seed)}, {"ember:first_sample", std::to_string(a.firstSample)},
+      {"ember:render_seconds", std::to_string(stats.seconds)},
+      {"ember:version", EMBER_VERSION},   {"DateTime", isoTime()},
+      {"Software", std::string("ember ") + EMBER_VERSION}};
+  writeExr(a.output, image, meta);
+  if (!a.variance.empty()) writeExr(a.variance, film.varianceOfMean(), meta);
+  if (!a.png.empty()) {
+    const ReinhardResult tm = tonemapReinhard(image, ReinhardParams{});
+    writePng(a.png, image.width, image.height, tm.rgb8);
+  }
+
+  const double secs = std::max(stats.seconds, 1e-9);
+  const uint64_t rays = stats.paths.rays + stats.paths.shadowRays;
+  std::fprintf(stderr,
+               "ember: %dx%d, %d spp, %d threads: load+build %.3f s, render %.3f s, %.3f M samples/s, "
+               "%.3f M rays/s (%.3f M closest-hit + %.3f M shadow), %llu non-finite samples dropped -> %s\n",
+               s.width, s.height, s.spp, stats.threads, loadSeconds, stats.seconds,
+               double(stats.samples) / secs * 1e-6, double(rays) / secs * 1e-6,
+               double(stats.paths.rays) / secs * 1e-6, double(stats.paths.shadowRays) / secs * 1e-6,
+               static_cast<unsigned long long>(stats.nonFinite), a.output.c_str());
+  return 0;
+}
+
+}  // namespace
+
+Runner addRenderCommand(CLI::App& app) {
+  auto args = std::make_shared<RenderArgs>();
+  CLI::App* cmd = app.add_subcommand("render", "Render a scene (Ember JSON, .gltf or .glb) to a linear float EXR");
+  cmd->add_option("scene", args->scene, "Scene file: Ember JSON (docs/scene-format.md), .gltf or .glb")->required();
+  cmd->add_option("-o,--output", args->output, "Output EXR (linear float32 RGB), written atomically")->required();
+  cmd->add_option("--png", args->png, "Also write a tone-mapped (Reinhard 2002) sRGB PNG");
+  cmd->add_option("--spp", args->spp, "Samples per pixel (default: the scene's render.spp, else 64)")->check(CLI::Range(1, 1 << 24));
+  cmd->add_option("--seed", args->seed, "Random seed (default: the scene's render.seed, else 0)");
+  cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 4096));
+  cmd->add_option("--width", args->width, "Image width in pixels (overrides the scene)")->check(CLI::Range(1, 16384));
+  cmd->add_option("--height", args->height, "Image height in pixels (overrides the scene)")->check(CLI::Range(1, 16384));
+  cmd->add_option("--max-depth", args->maxDepth, "Longest path in segments; -1 = unbounded with Russian roulette")->check(CLI::Range(-1, 100000));
+  cmd->add_option("--first-sample", args->firstSample,
+                  "Index of the first sample to render: renders [first, first + spp), so separate runs can be merged");
+  cmd->add_option("--variance", args->variance, "Also write the per-pixel variance of the mean as an EXR");
+  cmd->add_flag("-q,--quiet", args->quiet, "No progress display (the summary line is still printed)");
+  return [args] { return runRender(*args); };
+}
+
+}  // namespace ember::cli

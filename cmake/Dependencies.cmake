@@ -1,0 +1,15 @@
+# All dependencies come from Debian 12 packages (scripts/setup-deps.sh installs them).
+# Versions and quirks: ../shared/docs/debian-toolchain.md.
+find_package(embree 3.13 REQUIRED CONFIG)
+find_package(OpenImageIO 2.4 REQUIRED CONFIG)
+find_package(TinyGLTF REQUIRED CONFIG)
+find_package(glm REQUIRED CONFIG)
+find_package(TBB REQUIRED CONFIG)
+find_package(CLI11 REQUIRED CONFIG)
+find_package(nlohmann_json 3.10 REQUIRED CONFIG)
+find_package(Threads REQUIRED)
+
+# Quirk 1: OIIO's exported target names /usr/include/opencv4, which is absent without libopencv-dev.
+get_target_property(_ember_oiio_inc OpenImageIO::OpenImageIO INTERFACE_INCLUDE_DIRECTORIES)
+list(FILTER _ember_oiio_inc EXCLUDE REGEX "opencv")
+set_target_properties(OpenImageIO::OpenImageIO PROPERTIES INTERFACE_INCLUDE_DIRECTORIES "${_ember_oiio_inc}")

@@ -1,0 +1,345 @@
+#include "io/gltf_loader.h"
+
+#include "io/image_io.h"
+#include "io/input_error.h"
+#include "materials/lambertian.h"
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <tiny_gltf.h>
+
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <set>
+
+namespace ember {
+
+namespace {
+
+constexpr int kModeTriangles = 4, kModeStrip = 5, kModeFan = 6;
+
+class GltfImporter {
+ public:
+  GltfImporter(const std::string& path, Scene& scene, const Material* override)
+      : path_(path), scene_(scene), override_(override) {}
+
+  GltfImport run(const Mat4& transform) {
+    load();
+    std::vector<int> roots;
+    if (!model_.scenes.empty()) {
+      int sceneIndex = model_.defaultScene;
+      if (sceneIndex < 0 || size_t(sceneIndex) >= model_.scenes.size()) sceneIndex = 0;
+      roots = model_.scenes[size_t(sceneIndex)].nodes;
+    } else {
+      // No scene at all: every node that is nobody's child is a root.
+      std::set<int> children;
+      for (const auto& node : model_.nodes) children.insert(node.children.begin(), node.children.end());
+      for (int i = 0; i < int(model_.nodes.size()); ++i)
+        if (!children.count(i)) roots.push_back(i);
+    }
+    std::vector<int> stack;
+    for (int root : roots) visit(root, transform, stack);
+    return result_;
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& where, const std::string& what) const {
+    throw InputError(path_ + ": " + where + ": " + what);
+  }
+
+  void load() {
+    namespace fs = std::filesystem;
+    if (!fs::exists(path_)) throw InputError(path_ + ": no such file");
+    tinygltf::TinyGLTF loader;
+    std::string err, warn;
+    std::string ext = fs::path(path_).extension().string();
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    const bool ok = ext == ".glb" ? loader.LoadBinaryFromFile(&model_, &err, &warn, path_)
+                                  : loader.LoadASCIIFromFile(&model_, &err, &warn, path_);
+    if (!ok) {
+      while (!err.empty() && (err.back() == '\n' || err.back() == '\r')) err.pop_back();
+      throw InputError(path_ + ": cannot load glTF: " + (err.empty() ? "unknown error" : err));
+    }
+  }
+
+  static Mat4 localMatrix(const tinygltf::Node& node) {
+    if (node.matrix.size() == 16) {
+      Mat4 m;
+      for (int i = 0; i < 16; ++i) m[i / 4][i % 4] = float(node.matrix[size_t(i)]);  // column-major
+      return m;
+    }
+    Mat4 m(1.0f);
+    if (node.translation.size() == 3)
+      m = glm::translate(m, Vec3(float(node.translation[0]), float(node.translation[1]), float(node.translation[2])));
+    if (node.rotation.size() == 4) {
+      const glm::quat q(float(node.rotation[3]), float(node.rotation[0]), float(node.rotation[1]),
+                        float(node.rotation[2]));  // glTF stores x, y, z, w
+      m = m * glm::mat4_cast(glm::normalize(q));
+    }
+    if (node.scale.size() == 3)
+      m = glm::scale(m, Vec3(float(node.scale[0]), float(node.scale[1]), float(node.scale[2])));
+    return m;
+  }
+
+  void visit(int index, const Mat4& parent, std::vector<int>& stack) {
+    const std::string where = "nodes[" + std::to_string(index) + "]";
+    if (index < 0 || size_t(index) >= model_.nodes.size()) fail(where, "node index out of range");
+    for (int s : stack)
+      if (s == index) fail(where, "the node hierarchy contains a cycle");
+    const tinygltf::Node& node = model_.nodes[size_t(index)];
+    const Mat4 world = parent * localMatrix(node);
+    for (int i = 0; i < 16; ++i)
+      if (!std::isfinite(world[i / 4][i % 4])) fail(where, "non-finite transform");
+    if (node.camera >= 0 && !result_.camera) readCamera(node.camera, world);
+    if (node.mesh >= 0) {
+      if (size_t(node.mesh) >= model_.meshes.size()) fail(where + ".mesh", "mesh index out of range");
+      const tinygltf::Mesh& mesh = model_.meshes[size_t(node.mesh)];
+      for (size_t p = 0; p < mesh.primitives.size(); ++p)
+        readPrimitive(mesh.primitives[p], world,
+                      "meshes[" + std::to_string(node.mesh) + "].primitives[" + std::to_string(p) + "]");
+    }
+    stack.push_back(index);
+    for (int child : node.children) visit(child, world, stack);
+    stack.pop_back();
+  }
+
+  void readCamera(int index, const Mat4& world) {
+    if (size_t(index) >= model_.cameras.size()) return;
+    const tinygltf::Camera& cam = model_.cameras[size_t(index)];
+    if (cam.type != "perspective") {
+      std::fprintf(stderr, "ember: %s: camera %d is %s; only perspective cameras are used, framing the scene instead\n",
+                   path_.c_str(), index, cam.type.c_str());
+      return;
+    }
+    CameraParams c;
+    c.origin = Vec3(world * glm::vec4(0, 0, 0, 1));
+    const Vec3 forward = glm::normalize(Vec3(world * glm::vec4(0, 0, -1, 0)));
+    c.target = c.origin + forward;
+    c.up = glm::normalize(Vec3(world * glm::vec4(0, 1, 0, 0)));
+    c.fovYDeg = glm::degrees(float(cam.perspective.yfov));
+    if (!(c.fovYDeg > 0.0f && c.fovYDeg < 180.0f) || !isFinite(c.origin) || !isFinite(forward)) return;
+    result_.camera = c;
+    result_.cameraAspect = float(cam.perspective.aspectRatio);
+  }
+
+  // Reads `count` elements of accessor `index` as floats (normalised integers are converted),
+  // after checking every byte it touches lies inside its buffer view and buffer.
+  std::vector<float> readFloats(int index, int expectedType, const std::string& where, size_t& count) {
+    const tinygltf::Accessor& acc = checkedAccessor(index, where);
+    if (acc.type != expectedType) fail(where, "unexpected accessor type");
+    const int components = tinygltf::GetNumComponentsInType(uint32_t(acc.type));
+    count = acc.count;
+    std::vector<float> out(count * size_t(components), 0.0f);
+    forEachElement(acc, where, [&](const uint8_t* src, size_t i) {
+      for (int c = 0; c < components; ++c) {
+        float v;
+        switch (acc.componentType) {
+          case TINYGLTF_COMPONENT_TYPE_FLOAT: std::memcpy(&v, src + 4 * c, 4); break;
+          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: v = src[c] / 255.0f; break;
+          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+            uint16_t s;
+            std::memcpy(&s, src + 2 * c, 2);
+            v = s / 65535.0f;
+            break;
+          }
+          default: fail(where, "unsupported component type " + std::to_string(acc.componentType));
+        }
+        if (!std::isfinite(v)) fail(where, "contains NaN or infinite values");
+        out[i * size_t(components) + size_t(c)] = v;
+      }
+    });
+    return out;
+  }
+
+  std::vector<uint32_t> readIndices(int index, const std::string& where) {
+    const tinygltf::Accessor& acc = checkedAccessor(index, where);
+    if (acc.type != TINYGLTF_TYPE_SCALAR) fail(where, "index accessor must be SCALAR");
+    std::vector<uint32_t> out(acc.count);
+    forEachElement(acc, where, [&](const uint8_t* src, size_t i) {
+      switch (acc.componentType) {
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: out[i] = src[0]; break;
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+          uint16_t s;
+          std::memcpy(&s, src, 2);
+          out[i] = s;
+          break;
+        }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: std::memcpy(&out[i], src, 4); break;
+        default: fail(where, "index component type must be an unsigned integer");
+      }
+    });
+    return out;
+  }
+
+  const tinygltf::Accessor& checkedAccessor(int index, const std::string& where) const {
+    if (index < 0 || size_t(index) >= model_.accessors.size())
+      fail(where, "accessor index " + std::to_string(index) + " out of range");
+    return model_.accessors[size_t(index)];
+  }
+
+  template <typename Fn>
+  void forEachElement(const tinygltf::Accessor& acc, const std::string& where, Fn fn) const {
+    if (acc.sparse.isSparse) fail(where, "sparse accessors are not supported");
+    if (acc.bufferView < 0) return;  // spec: no buffer view means all zeros
+    if (size_t(acc.bufferView) >= model_.bufferViews.size()) fail(where, "bufferView index out of range");
+    const tinygltf::BufferView& view = model_.bufferViews[size_t(acc.bufferView)];
+    if (view.buffer < 0 || size_t(view.buffer) >= model_.buffers.size()) fail(where, "buffer index out of range");
+    const tinygltf::Buffer& buffer = model_.buffers[size_t(view.buffer)];
+    const int componentSize = tinygltf::GetComponentSizeInBytes(uint32_t(acc.componentType));
+    const int components = tinygltf::GetNumComponentsInType(uint32_t(acc.type));
+    if (componentSize <= 0 || components <= 0) fail(where, "invalid component type or accessor type");
+    const size_t elementSize = size_t(componentSize) * size_t(components);
+    const size_t stride = view.byteStride ? view.byteStride : elementSize;
+    if (stride < elementSize) fail(where, "byteStride smaller than the element size");
+    if (view.byteOffset > buffer.data.size() || view.byteLength > buffer.data.size() - view.byteOffset)
+      fail(where, "bufferView extends past the end of its buffer (buffer has " +
+                      std::to_string(buffer.data.size()) + " bytes)");
+    if (acc.count == 0) return;
+    const size_t needed = acc.byteOffset + stride * (acc.count - 1) + elementSize;
+    if (acc.byteOffset > view.byteLength || needed > view.byteLength || needed < acc.byteOffset)
+      fail(where, "accessor reads past the end of its bufferView");
+    const uint8_t* base = buffer.data.data() + view.byteOffset + acc.byteOffset;
+    for (size_t i = 0; i < acc.count; ++i) fn(base + i * stride, i);
+  }
+
+  void readPrimitive(const tinygltf::Primitive& prim, const Mat4& world, const std::string& where) {
+    const int mode = prim.mode < 0 ? kModeTriangles : prim.mode;
+    if (mode != kModeTriangles && mode != kModeStrip && mode != kModeFan) {
+      std::fprintf(stderr, "ember: %s: %s: skipping a primitive of mode %d (points or lines)\n",
+                   path_.c_str(), where.c_str(), mode);
+      return;
+    }
+    const auto pos = prim.attributes.find("POSITION");
+    if (pos == prim.attributes.end()) fail(where, "primitive has no POSITION attribute");
+    size_t vertexCount = 0;
+    const std::vector<float> positions = readFloats(pos->second, TINYGLTF_TYPE_VEC3, where + ".attributes.POSITION", vertexCount);
+
+    auto mesh = std::make_unique<TriangleMesh>();
+    mesh->name = where;
+    const glm::mat3 normalMatrix = glm::transpose(glm::inverse(glm::mat3(world)));
+    mesh->positions.resize(vertexCount);
+    for (size_t i = 0; i < vertexCount; ++i)
+      mesh->positions[i] = Vec3(world * glm::vec4(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2], 1.0f));
+
+    if (const auto nrm = prim.attributes.find("NORMAL"); nrm != prim.attributes.end()) {
+      size_t n = 0;
+      const std::vector<float> normals = readFloats(nrm->second, TINYGLTF_TYPE_VEC3, where + ".attributes.NORMAL", n);
+      if (n != vertexCount) fail(where + ".attributes.NORMAL", "count differs from POSITION");
+      mesh->normals.resize(n);
+      for (size_t i = 0; i < n; ++i) {
+        const Vec3 v = normalMatrix * Vec3(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]);
+        const float len = glm::length(v);
+        mesh->normals[i] = len > 0.0f ? v / len : Vec3(0.0f);
+      }
+    }
+    if (const auto uv = prim.attributes.find("TEXCOORD_0"); uv != prim.attributes.end()) {
+      size_t n = 0;
+      const std::vector<float> uvs = readFloats(uv->second, TINYGLTF_TYPE_VEC2, where + ".attributes.TEXCOORD_0", n);
+      if (n != vertexCount) fail(where + ".attributes.TEXCOORD_0", "count differs from POSITION");
+      mesh->uvs.resize(n);
+      for (size_t i = 0; i < n; ++i) mesh->uvs[i] = Vec2(uvs[2 * i], uvs[2 * i + 1]);
+    }
+
+    std::vector<uint32_t> order;
+    if (prim.indices >= 0) {
+      order = readIndices(prim.indices, where + ".indices");
+      for (uint32_t idx : order)
+        if (idx >= vertexCount)
+          fail(where + ".indices", "index " + std::to_string(idx) + " out of range (" + std::to_string(vertexCount) + " vertices)");
+    } else {
+      order.resize(vertexCount);
+      for (size_t i = 0; i < vertexCount; ++i) order[i] = uint32_t(i);
+    }
+    appendTriangles(*mesh, order, mode);
+    if (mesh->indices.empty()) return;
+
+    result_.triangles += mesh->indices.size();
+    ++result_.primitives;
+    Color emission(0.0f);
+    const Material* material = override_ ? override_ : materialFor(prim.material, emission);
+    scene_.meshes.push_back({std::move(mesh), material, emission});
+  }
+
+  static void appendTriangles(TriangleMesh& mesh, const std::vector<uint32_t>& order, int mode) {
+    auto add = [&](uint32_t a, uint32_t b, uint32_t c) {
+      if (a == b || b == c || a == c) return;  // degenerate (strip restarts, bad data)
+      mesh.indices.emplace_back(a, b, c);
+    };
+    if (mode == kModeTriangles) {
+      for (size_t i = 0; i + 2 < order.size(); i += 3) add(order[i], order[i + 1], order[i + 2]);
+    } else if (mode == kModeStrip) {
+      for (size_t i = 0; i + 2 < order.size(); ++i)
+        i % 2 ? add(order[i + 1], order[i], order[i + 2]) : add(order[i], order[i + 1], order[i + 2]);
+    } else {
+      for (size_t i = 1; i + 1 < order.size(); ++i) add(order[0], order[i], order[i + 1]);
+    }
+  }
+
+  const Material* materialFor(int index, Color& emission) {
+    if (index < 0 || size_t(index) >= model_.materials.size()) {
+      if (!defaultMaterial_)
+        defaultMaterial_ = scene_.addMaterial("(glTF default)", std::make_unique<Lambertian>(std::make_shared<ConstantTexture>(Color(0.8f))));
+      return defaultMaterial_;
+    }
+    const tinygltf::Material& m = model_.materials[size_t(index)];
+    if (m.emissiveFactor.size() == 3)
+      emission = Color(float(m.emissiveFactor[0]), float(m.emissiveFactor[1]), float(m.emissiveFactor[2]));
+    if (!isFinite(emission)) emission = Color(0.0f);
+    if (const auto it = materials_.find(index); it != materials_.end()) return it->second;
+
+    const auto& pbr = m.pbrMetallicRoughness;
+    Color factor(1.0f);
+    if (pbr.baseColorFactor.size() >= 3)
+      factor = glm::clamp(Color(float(pbr.baseColorFactor[0]), float(pbr.baseColorFactor[1]), float(pbr.baseColorFactor[2])),
+                          Color(0.0f), Color(1.0f));
+    std::shared_ptr<const Texture> albedo = baseColorTexture(pbr.baseColorTexture.index, factor, index);
+    if (!albedo) albedo = std::make_shared<ConstantTexture>(factor);
+    const std::string name = m.name.empty() ? "material" + std::to_string(index) : m.name;
+    return materials_[index] = scene_.addMaterial(name, std::make_unique<Lambertian>(std::move(albedo)));
+  }
+
+  std::shared_ptr<const Texture> baseColorTexture(int textureIndex, const Color& factor, int materialIndex) {
+    if (textureIndex < 0) return nullptr;
+    const std::string where = "materials[" + std::to_string(materialIndex) + "].baseColorTexture";
+    if (size_t(textureIndex) >= model_.textures.size()) fail(where, "texture index out of range");
+    const tinygltf::Texture& tex = model_.textures[size_t(textureIndex)];
+    if (tex.source < 0 || size_t(tex.source) >= model_.images.size()) fail(where, "image index out of range");
+    const tinygltf::Image& img = model_.images[size_t(tex.source)];
+    if (img.width <= 0 || img.height <= 0 || img.image.empty() || img.bits != 8) {
+      std::fprintf(stderr, "ember: %s: %s: image could not be used (need 8-bit pixels); using baseColorFactor\n",
+                   path_.c_str(), where.c_str());
+      return nullptr;
+    }
+    const size_t expected = size_t(img.width) * size_t(img.height) * size_t(img.component);
+    if (img.component < 1 || img.image.size() < expected) fail(where, "decoded image is smaller than its size says");
+    TextureImage decoded = textureFromBytes(img.image.data(), img.width, img.height, img.component, /*srgb=*/true);
+    TextureWrap wrap = TextureWrap::Repeat;
+    TextureFilter filter = TextureFilter::Bilinear;
+    if (tex.sampler >= 0 && size_t(tex.sampler) < model_.samplers.size()) {
+      const tinygltf::Sampler& s = model_.samplers[size_t(tex.sampler)];
+      if (s.wrapS == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE) wrap = TextureWrap::Clamp;
+      if (s.wrapS == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT) wrap = TextureWrap::Mirror;
+      if (s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST) filter = TextureFilter::Nearest;
+    }
+    return std::make_shared<ImageTexture>(decoded.width, decoded.height, std::move(decoded.texels), filter, wrap, factor);
+  }
+
+  std::string path_;
+  Scene& scene_;
+  const Material* override_;
+  tinygltf::Model model_;
+  GltfImport result_;
+  std::map<int, const Material*> materials_;
+  const Material* defaultMaterial_ = nullptr;
+};
+
+}  // namespace
+
+GltfImport importGltf(const std::string& path, Scene& scene, const Mat4& transform,
+                      const Material* materialOverride) {
+  return GltfImporter(path, scene, materialOverride).run(transform);
+}
+
+}  // namespace ember

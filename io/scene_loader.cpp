@@ -1,0 +1,399 @@
+#include "io/scene_loader.h"
+
+#include "accel/box.h"
+#include "accel/cone.h"
+#include "accel/cylinder.h"
+#include "accel/disc.h"
+#include "accel/sphere.h"
+#include "accel/triangle.h"
+#include "io/gltf_loader.h"
+#include "io/image_io.h"
+#include "io/json_reader.h"
+#include "materials/lambertian.h"
+#include "materials/mixed.h"
+#include "materials/phong.h"
+#include "materials/specular.h"
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <filesystem>
+#include <map>
+
+namespace ember {
+
+namespace fs = std::filesystem;
+
+bool isGltfPath(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".gltf" || ext == ".glb";
+}
+
+namespace {
+
+class JsonSceneLoader {
+ public:
+  JsonSceneLoader(const std::string& path, Scene& scene)
+      : path_(path), baseDir_(fs::path(path).parent_path()), scene_(scene) {}
+
+  void load(const JsonNode& root) {
+    root.allowKeys({"image", "camera", "render", "materials", "shapes", "lights", "description", "name"});
+    if (auto image = root.find("image")) readImage(*image);
+    readCamera(root.at("camera"));
+    if (auto render = root.find("render")) readRender(*render);
+    if (auto materials = root.find("materials")) readMaterials(*materials);
+    if (auto shapes = root.find("shapes"))
+      for (size_t i = 0; i < shapes->arraySize(); ++i) readShape((*shapes)[i]);
+    if (auto lights = root.find("lights"))
+      for (size_t i = 0; i < lights->arraySize(); ++i) readLight((*lights)[i]);
+  }
+
+ private:
+  void readImage(const JsonNode& n) {
+    n.allowKeys({"width", "height"});
+    if (n.has("width")) scene_.settings.width = n.at("width").integer(1, 16384);
+    if (n.has("height")) scene_.settings.height = n.at("height").integer(1, 16384);
+  }
+
+  void readCamera(const JsonNode& n) {
+    n.allowKeys({"type", "origin", "target", "up", "fov_y_deg"});
+    if (n.has("type") && n.at("type").string() != "pinhole")
+      n.at("type").fail("unknown camera type; valid types are: pinhole");
+    CameraParams& c = scene_.cameraParams;
+    c.origin = n.at("origin").vec3();
+    c.target = n.at("target").vec3();
+    c.up = n.has("up") ? n.at("up").direction() : Vec3(0.0f, 1.0f, 0.0f);
+    c.fovYDeg = n.has("fov_y_deg") ? n.at("fov_y_deg").positive() : 40.0f;
+    if (c.fovYDeg >= 180.0f) n.at("fov_y_deg").fail("expected a number in (0, 180)");
+    const Vec3 f = c.target - c.origin;
+    if (glm::length(f) == 0.0f) n.at("target").fail("must differ from origin");
+    if (glm::length(glm::cross(glm::normalize(f), c.up)) < 1e-6f) n.at("up").fail("must not be parallel to the view direction");
+  }
+
+  void readRender(const JsonNode& n) {
+    n.allowKeys({"spp", "max_depth", "rr_depth", "seed", "background"});
+    RenderSettings& s = scene_.settings;
+    if (n.has("spp")) s.spp = n.at("spp").integer(1, 1 << 24);
+    if (n.has("max_depth")) s.maxDepth = n.at("max_depth").integer(-1, 100000);
+    if (n.has("rr_depth")) s.rrDepth = n.at("rr_depth").integer(1, 100000);
+    if (n.has("seed")) s.seed = n.at("seed").unsignedInteger();
+    scene_.background = n.color("background", Color(0.0f));
+  }
+
+  std::shared_ptr<const Texture> readTexture(const JsonNode& n) {
+    if (!n.isObject()) return std::make_shared<ConstantTexture>(n.color());
+    n.allowKeys({"texture", "encoding", "filter", "wrap", "scale"});
+    const JsonNode file = n.at("texture");
+    ColorEncoding encoding = ColorEncoding::Auto;
+    if (auto e = n.find("encoding")) {
+      const std::string v = e->string();
+      if (v == "srgb") encoding = ColorEncoding::Srgb;
+      else if (v == "linear") encoding = ColorEncoding::Linear;
+      else if (v != "auto") e->fail("unknown encoding '" + v + "'; valid: auto, srgb, linear");
+    }
+    TextureFilter filter = TextureFilter::Bilinear;
+    if (auto f = n.find("filter")) {
+      const std::string v = f->string();
+      if (v == "nearest") filter = TextureFilter::Nearest;
+      else if (v != "bilinear") f->fail("unknown filter '" + v + "'; valid: nearest, bilinear");
+    }
+    TextureWrap wrap = TextureWrap::Repeat;
+    if (auto w = n.find("wrap")) {
+      const std::string v = w->string();
+      if (v == "clamp") wrap = TextureWrap::Clamp;
+      else if (v == "mirror") wrap = TextureWrap::Mirror;
+      else if (v != "repeat") w->fail("unknown wrap '" + v + "'; valid: clamp, repeat, mirror");
+    }
+    const fs::path texPath = baseDir_ / file.string();
+    TextureImage img;
+    try {
+      img = ember::readTexture(texPath.string(), encoding);
+    } catch (const InputError& e) {
+      file.fail(e.what());
+    }
+    return std::make_shared<ImageTexture>(img.width, img.height, std::move(img.texels), filter, wrap,
+                                          n.color("scale", Color(1.0f)));
+  }
+
+  void readMaterials(const JsonNode& n) {
+    n.requireObject();
+    for (auto it = n.raw().begin(); it != n.raw().end(); ++it) {
+      const JsonNode m = n.at(it.key());
+      materials_[it.key()] = scene_.addMaterial(it.key(), readMaterial(m));
+    }
+  }
+
+  std::unique_ptr<Material> readMaterial(const JsonNode& m) {
+    const std::string type = m.at("type").string();
+    if (type == "diffuse" || type == "lambertian") {
+      m.allowKeys({"type", "reflectance"});
+      auto r = m.has("reflectance") ? readTexture(m.at("reflectance"))
+                                    : std::make_shared<ConstantTexture>(Color(0.5f));
+      if (maxComponent(r->maxValue()) > 1.0f) m.at("reflectance").fail("reflectance must be <= 1");
+      return std::make_unique<Lambertian>(std::move(r));
+    }
+    if (type == "phong") {
+      m.allowKeys({"type", "kd", "ks", "exponent"});
+      auto kd = m.has("kd") ? readTexture(m.at("kd")) : std::make_shared<ConstantTexture>(Color(0.5f));
+      const Color ks = m.color("ks", Color(0.0f));
+      const float exponent = m.positive("exponent", 32.0f);
+      const Color sum = kd->maxValue() + ks;
+      if (maxComponent(sum) > 1.0f + 1e-6f) m.fail("kd + ks must be <= 1 in every channel (energy conservation)");
+      return std::make_unique<Phong>(std::move(kd), ks, exponent);
+    }
+    if (type == "mirror") {
+      m.allowKeys({"type", "reflectance"});
+      return std::make_unique<Mirror>(m.color("reflectance", Color(1.0f)));
+    }
+    if (type == "refraction") {
+      m.allowKeys({"type", "ior_inside", "ior_outside", "transmittance"});
+      return std::make_unique<Refraction>(m.color("transmittance", Color(1.0f)),
+                                          m.positive("ior_inside", 1.5f), m.positive("ior_outside", 1.0f));
+    }
+    if (type == "dielectric") {
+      m.allowKeys({"type", "ior_inside", "ior_outside"});
+      return std::make_unique<Dielectric>(m.positive("ior_inside", 1.5f), m.positive("ior_outside", 1.0f));
+    }
+    if (type == "mixed") {
+      m.allowKeys({"type", "kd", "ks", "kr", "kt", "exponent", "ior"});
+      MixedCoefficients c;
+      c.kd = m.has("kd") ? readTexture(m.at("kd")) : std::make_shared<ConstantTexture>(Color(0.0f));
+      c.ks = m.color("ks", Color(0.0f));
+      c.kr = m.color("kr", Color(0.0f));
+      c.kt = m.color("kt", Color(0.0f));
+      c.exponent = m.positive("exponent", 32.0f);
+      c.ior = m.positive("ior", 1.5f);
+      const Color kdMax = c.kd->maxValue();
+      const float probabilities = maxComponent(kdMax) + maxComponent(c.ks) + maxComponent(c.kr) + maxComponent(c.kt);
+      if (probabilities > 1.0f + 1e-6f)
+        m.fail("the largest channels of kd, ks, kr and kt must sum to <= 1 (they are event probabilities)");
+      return std::make_unique<Mixed>(std::move(c));
+    }
+    m.at("type").fail("unknown material type '" + type +
+                      "'; valid types are: diffuse, phong, mirror, refraction, dielectric, mixed");
+  }
+
+  const Material* materialFor(const JsonNode& s, bool emissive) {
+    if (!s.has("material")) {
+      if (emissive) return blackMaterial();
+      s.at("material");  // reports it as missing
+    }
+    const JsonNode m = s.at("material");
+    const std::string name = m.string();
+    const auto it = materials_.find(name);
+    if (it == materials_.end()) {
+      std::string valid;
+      for (const auto& [k, v] : materials_) valid += (valid.empty() ? "" : ", ") + k;
+      m.fail("unknown material '" + name + "'; defined materials are: " + (valid.empty() ? "(none)" : valid));
+    }
+    return it->second;
+  }
+
+  const Material* blackMaterial() {
+    if (!black_)
+      black_ = scene_.addMaterial("(black)", std::make_unique<Lambertian>(std::make_shared<ConstantTexture>(Color(0.0f))));
+    return black_;
+  }
+
+  static std::string shapeName(const JsonNode& s, const std::string& type) {
+    if (s.has("id")) return s.at("id").string();
+    if (s.has("name")) return s.at("name").string();
+    return type;
+  }
+
+  void readShape(const JsonNode& s) {
+    const std::string type = s.at("type").string();
+    const Color emission = s.color("emission", Color(0.0f));
+    auto common = [&](std::initializer_list<std::string_view> extra) {
+      std::vector<std::string_view> keys{"type", "id", "name", "material", "emission"};
+      keys.insert(keys.end(), extra.begin(), extra.end());
+      checkKeys(s, keys);
+    };
+    std::unique_ptr<Shape> shape;
+    if (type == "sphere") {
+      common({"center", "radius"});
+      shape = std::make_unique<Sphere>(s.at("center").vec3(), s.at("radius").positive());
+    } else if (type == "disc" || type == "disk") {
+      common({"center", "normal", "radius"});
+      shape = std::make_unique<Disc>(s.at("center").vec3(), s.at("normal").direction(), s.at("radius").positive());
+    } else if (type == "cylinder") {
+      common({"p0", "p1", "radius", "caps"});
+      const Vec3 p0 = s.at("p0").vec3(), p1 = s.at("p1").vec3();
+      if (!(glm::length(p1 - p0) > 0.0f)) s.at("p1").fail("must differ from p0");
+      shape = std::make_unique<Cylinder>(p0, p1, s.at("radius").positive(), s.boolean("caps", true));
+    } else if (type == "cone") {
+      common({"base_center", "apex", "radius", "cap_base"});
+      const Vec3 base = s.at("base_center").vec3(), apex = s.at("apex").vec3();
+      if (!(glm::length(apex - base) > 0.0f)) s.at("apex").fail("must differ from base_center");
+      shape = std::make_unique<Cone>(base, apex, s.at("radius").positive(), s.boolean("cap_base", true));
+    } else if (type == "box") {
+      common({"center", "size", "rotate_y_deg", "rotation"});
+      const JsonNode size = s.at("size");
+      const Vec3 sz(size[0].positive(), size[1].positive(), size[2].positive());
+      if (size.arraySize() != 3) size.fail("expected an array of 3 numbers > 0");
+      glm::mat3 rotation(1.0f);
+      if (auto r = s.find("rotate_y_deg"))
+        rotation = glm::mat3(glm::rotate(Mat4(1.0f), glm::radians(r->number()), Vec3(0.0f, 1.0f, 0.0f)));
+      if (auto r = s.find("rotation")) rotation = glm::mat3(readRotation(*r)) * rotation;
+      shape = std::make_unique<Box>(s.at("center").vec3(), sz, rotation);
+    } else if (type == "triangle") {
+      common({"vertices", "uvs"});
+      std::array<Vec3, 3> v = readPoints<3>(s.at("vertices"));
+      std::array<Vec2, 3> uv{Vec2(0, 0), Vec2(1, 0), Vec2(0, 1)};
+      if (auto u = s.find("uvs")) uv = readUvs<3>(*u);
+      if (!(glm::length(glm::cross(v[1] - v[0], v[2] - v[0])) > 0.0f)) s.at("vertices").fail("degenerate triangle (zero area)");
+      shape = std::make_unique<Triangle>(v, uv);
+    } else if (type == "quad") {
+      common({"vertices", "uvs", "front_normal"});
+      std::array<Vec3, 4> v = readPoints<4>(s.at("vertices"));
+      std::array<Vec2, 4> uv{Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)};
+      if (auto u = s.find("uvs")) uv = readUvs<4>(*u);
+      if (!(glm::length(glm::cross(v[1] - v[0], v[2] - v[0])) > 0.0f)) s.at("vertices").fail("degenerate quad (zero area)");
+      shape = std::make_unique<Quad>(v, uv);
+    } else if (type == "mesh") {
+      common({"file", "transform"});
+      readMesh(s, emission);
+      return;
+    } else {
+      s.at("type").fail("unknown shape type '" + type +
+                        "'; valid types are: sphere, disc, cylinder, cone, box, triangle, quad, mesh");
+    }
+    scene_.shapes.push_back({shapeName(s, type), std::move(shape), materialFor(s, !isBlack(emission)), emission});
+  }
+
+  static void checkKeys(const JsonNode& s, const std::vector<std::string_view>& keys) {
+    s.requireObject();
+    for (auto it = s.raw().begin(); it != s.raw().end(); ++it) {
+      bool known = it.key() == "note";
+      for (std::string_view k : keys) known = known || it.key() == k;
+      if (known) continue;
+      std::string valid;
+      for (std::string_view k : keys) valid += (valid.empty() ? "" : ", ") + std::string(k);
+      s.at(it.key()).fail("unknown key; valid keys for this shape are: " + valid);
+    }
+  }
+
+  template <size_t N>
+  static std::array<Vec3, N> readPoints(const JsonNode& n) {
+    if (n.arraySize() != N) n.fail("expected " + std::to_string(N) + " vertices");
+    std::array<Vec3, N> out;
+    for (size_t i = 0; i < N; ++i) out[i] = n[i].vec3();
+    return out;
+  }
+  template <size_t N>
+  static std::array<Vec2, N> readUvs(const JsonNode& n) {
+    if (n.arraySize() != N) n.fail("expected " + std::to_string(N) + " uv pairs");
+    std::array<Vec2, N> out;
+    for (size_t i = 0; i < N; ++i) out[i] = n[i].vec2();
+    return out;
+  }
+
+  static Mat4 readRotation(const JsonNode& r) {
+    r.allowKeys({"axis", "degrees"});
+    return glm::rotate(Mat4(1.0f), glm::radians(r.at("degrees").number()), r.at("axis").direction());
+  }
+
+  static Mat4 readTransform(const JsonNode& t) {
+    t.allowKeys({"matrix", "translate", "rotate", "rotate_y_deg", "scale"});
+    if (auto m = t.find("matrix")) {
+      if (t.raw().size() != 1) t.fail("'matrix' cannot be combined with translate/rotate/scale");
+      if (m->arraySize() != 16) m->fail("expected 16 numbers (row-major 4x4)");
+      Mat4 out;
+      for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) out[c][r] = (*m)[size_t(r * 4 + c)].number();
+      return out;
+    }
+    // Applied to points as scale, then rotate, then translate.
+    Mat4 out(1.0f);
+    if (auto tr = t.find("translate")) out = glm::translate(out, tr->vec3());
+    if (auto r = t.find("rotate")) out = out * readRotation(*r);
+    if (auto r = t.find("rotate_y_deg")) out = glm::rotate(out, glm::radians(r->number()), Vec3(0, 1, 0));
+    if (auto sc = t.find("scale")) {
+      const Vec3 s = sc->isNumber() ? Vec3(sc->positive()) : sc->vec3();
+      if (!(s.x > 0 && s.y > 0 && s.z > 0)) sc->fail("expected scale factors > 0");
+      out = glm::scale(out, s);
+    }
+    return out;
+  }
+
+  void readMesh(const JsonNode& s, const Color& emission) {
+    const JsonNode file = s.at("file");
+    const fs::path meshPath = baseDir_ / file.string();
+    const Mat4 transform = s.has("transform") ? readTransform(s.at("transform")) : Mat4(1.0f);
+    const Material* override = s.has("material") ? materialFor(s, false) : nullptr;
+    const size_t first = scene_.meshes.size();
+    try {
+      importGltf(meshPath.string(), scene_, transform, override);
+    } catch (const InputError& e) {
+      file.fail(e.what());
+    }
+    if (!isBlack(emission))
+      for (size_t i = first; i < scene_.meshes.size(); ++i) scene_.meshes[i].emission = emission;
+  }
+
+  void readLight(const JsonNode& l) {
+    const std::string type = l.at("type").string();
+    if (type != "point") l.at("type").fail("unknown light type '" + type + "'; valid types are: point");
+    l.allowKeys({"type", "id", "name", "position", "intensity", "intensity_unit"});
+    scene_.lights.push_back(std::make_unique<PointLight>(l.at("position").vec3(), l.at("intensity").color()));
+  }
+
+  std::string path_;
+  fs::path baseDir_;
+  Scene& scene_;
+  std::map<std::string, const Material*> materials_;
+  const Material* black_ = nullptr;
+};
+
+// A camera that frames the bounds from the front (+z) and a little above.
+CameraParams framingCamera(const Bounds& b, float aspect) {
+  const Vec3 center = 0.5f * (b.lower + b.upper);
+  const float radius = std::max(0.5f * glm::length(b.upper - b.lower), 1e-3f);
+  CameraParams c;
+  c.fovYDeg = 40.0f;
+  const float halfFov = glm::radians(c.fovYDeg) * 0.5f * std::min(1.0f, aspect);
+  const float distance = 1.1f * radius / std::sin(halfFov);
+  c.origin = center + distance * glm::normalize(Vec3(0.0f, 0.35f, 1.0f));
+  c.target = center;
+  c.up = Vec3(0.0f, 1.0f, 0.0f);
+  return c;
+}
+
+Scene loadGltfScene(const std::string& path) {
+  Scene scene;
+  scene.sourcePath = path;
+  const GltfImport imported = importGltf(path, scene);
+  if (imported.triangles == 0) throw InputError(path + ": the scene contains no triangles to render");
+  Bounds bounds;
+  for (const auto& m : scene.meshes) bounds.extend(m.mesh->bounds());
+  scene.settings.height = 384;
+  if (imported.camera) {
+    scene.cameraParams = *imported.camera;
+    const float aspect = imported.cameraAspect > 0.0f ? imported.cameraAspect : 4.0f / 3.0f;
+    scene.settings.width = std::max(1, int(std::lround(384.0f * aspect)));
+  } else {
+    scene.settings.width = 512;
+    scene.cameraParams = framingCamera(bounds, 512.0f / 384.0f);
+  }
+  // glTF files rarely carry lights: a uniform white environment lights them like an overcast sky.
+  scene.background = Color(1.0f);
+  return scene;
+}
+
+}  // namespace
+
+Scene loadJsonScene(const std::string& path) {
+  const nlohmann::json doc = JsonNode::parseFile(path);
+  Scene scene;
+  scene.sourcePath = path;
+  JsonSceneLoader(path, scene).load(JsonNode(doc, "", path));
+  return scene;
+}
+
+Scene loadScene(const std::string& path) {
+  if (!fs::exists(path)) throw InputError(path + ": no such file");
+  if (fs::is_directory(path)) throw InputError(path + ": is a directory, not a scene file");
+  return isGltfPath(path) ? loadGltfScene(path) : loadJsonScene(path);
+}
+
+}  // namespace ember

@@ -1,0 +1,17 @@
+// Loads a scene file into a Scene (not yet built): Ember's JSON format (docs/scene-format.md), or a
+// glTF 2.0 file (.gltf / .glb) directly, which gets a camera and a default environment.
+// Bad input throws InputError naming the file and the JSON path.
+#pragma once
+
+#include "renderer/scene.h"
+
+#include <string>
+
+namespace ember {
+
+Scene loadScene(const std::string& path);
+Scene loadJsonScene(const std::string& path);
+
+bool isGltfPath(const std::string& path);
+
+}  // namespace ember

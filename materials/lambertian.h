@@ -1,0 +1,26 @@
+// Two-sided Lambertian diffuse reflector: f = R / pi on both sides (../shared/refs conventions),
+// sampled with a cosine-weighted hemisphere, so a sample's weight is exactly R.
+#pragma once
+
+#include "materials/material.h"
+#include "materials/texture.h"
+
+#include <memory>
+
+namespace ember {
+
+class Lambertian final : public Material {
+ public:
+  explicit Lambertian(std::shared_ptr<const Texture> reflectance) : reflectance_(std::move(reflectance)) {}
+
+  std::string_view typeName() const override { return "diffuse"; }
+  Color eval(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const override;
+  float pdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const override;
+  bool sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float uLobe, BsdfSample& out) const override;
+  bool hasNonDeltaLobes() const override { return !isBlack(reflectance_->maxValue()); }
+
+ private:
+  std::shared_ptr<const Texture> reflectance_;
+};
+
+}  // namespace ember

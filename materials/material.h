@@ -1,0 +1,47 @@
+// The interface every material implements: evaluate, sample and pdf, as next-event estimation with
+// multiple importance sampling needs them (Veach 1997, ch. 9). Directions point away from the
+// surface: wo towards the previous path vertex, wi towards the next one.
+#pragma once
+
+#include "renderer/surface_hit.h"
+
+#include <string_view>
+
+namespace ember {
+
+struct BsdfSample {
+  Vec3 wi;
+  Color weight;       // f(wo, wi) |cos theta_i| / pdf: what the path throughput is multiplied by
+  float pdf = 0.0f;   // solid-angle density of wi; for a delta lobe, the lobe's discrete probability
+  bool delta = false; // wi came from a Dirac lobe (mirror, refraction): no MIS with light sampling
+  float eta = 1.0f;   // relative index of refraction crossed (eta_t / eta_i), 1 for reflection
+};
+
+class Material {
+ public:
+  virtual ~Material() = default;
+  virtual std::string_view typeName() const = 0;
+
+  // f(wo, wi) |cos theta_i| of the non-delta lobes; Dirac lobes contribute nothing here.
+  virtual Color eval(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const = 0;
+  // Solid-angle density with which sample() produces wi through its non-delta lobes.
+  virtual float pdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const = 0;
+  // Samples wi; uLobe picks among lobes, u the direction within one. False: the path is absorbed.
+  virtual bool sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float uLobe,
+                      BsdfSample& out) const = 0;
+
+  // Whether eval can be non-zero, i.e. light sampling is worth a shadow ray.
+  virtual bool hasNonDeltaLobes() const { return true; }
+};
+
+// wo and wi on the same geometric side of the surface (a reflection, not a transmission).
+inline bool sameSide(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) {
+  return glm::dot(wo, hit.ng) * glm::dot(wi, hit.ng) > 0.0f;
+}
+
+// The shading normal turned to the side of wo: two-sided materials shade both sides alike.
+inline Vec3 facingNormal(const SurfaceHit& hit, const Vec3& wo) {
+  return glm::dot(wo, hit.ng) >= 0.0f ? hit.ns : -hit.ns;
+}
+
+}  // namespace ember

@@ -1,0 +1,67 @@
+// Colour textures looked up by surface UV. Image lookup follows ../shared/refs/CONVENTIONS.md:
+// texel column = floor(u * width), row = floor(v * height), row 0 = the first (top) row of the file,
+// no v flip (glTF uses the same convention). Texel values are stored linear.
+#pragma once
+
+#include "renderer/math.h"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace ember {
+
+class Texture {
+ public:
+  virtual ~Texture() = default;
+  virtual Color eval(Vec2 uv) const = 0;
+  // Largest value the texture can return per channel (used for sampling decisions).
+  virtual Color maxValue() const = 0;
+  // Mean over the texture's area.
+  virtual Color average() const = 0;
+};
+
+class ConstantTexture final : public Texture {
+ public:
+  explicit ConstantTexture(const Color& c) : value_(c) {}
+  Color eval(Vec2) const override { return value_; }
+  Color maxValue() const override { return value_; }
+  Color average() const override { return value_; }
+
+ private:
+  Color value_;
+};
+
+enum class TextureFilter { Nearest, Bilinear };
+enum class TextureWrap { Clamp, Repeat, Mirror };
+
+class ImageTexture final : public Texture {
+ public:
+  ImageTexture(int width, int height, std::vector<Color> texels, TextureFilter filter,
+               TextureWrap wrap, const Color& scale = Color(1.0f));
+  Color eval(Vec2 uv) const override;
+  Color maxValue() const override { return max_; }
+  Color average() const override { return average_; }
+  int width() const { return width_; }
+  int height() const { return height_; }
+
+ private:
+  Color texel(int x, int y) const;
+
+  int width_, height_;
+  std::vector<Color> texels_;
+  TextureFilter filter_;
+  TextureWrap wrap_;
+  Color scale_;
+  Color max_{0.0f}, average_{0.0f};
+};
+
+// The exact piecewise sRGB EOTF (IEC 61966-2-1) for one channel value in [0, 1].
+inline float srgbToLinear(float c) {
+  return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+inline float linearToSrgb(float c) {
+  return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
+}
+
+}  // namespace ember

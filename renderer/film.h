@@ -1,0 +1,58 @@
+// Per-pixel accumulation of radiance samples with a box filter one pixel wide: a pixel's value is
+// the mean of its own samples. Sums are kept in double, with the sum of squares, so the variance of
+// each pixel mean is available too.
+#pragma once
+
+#include "renderer/math.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace ember {
+
+// A linear float RGB image, row 0 at the top.
+struct Image {
+  int width = 0;
+  int height = 0;
+  std::vector<float> rgb;  // width * height * 3
+
+  Image() = default;
+  Image(int w, int h) : width(w), height(h), rgb(size_t(w) * size_t(h) * 3, 0.0f) {}
+  Color at(int x, int y) const {
+    const size_t i = (size_t(y) * size_t(width) + size_t(x)) * 3;
+    return {rgb[i], rgb[i + 1], rgb[i + 2]};
+  }
+  void set(int x, int y, const Color& c) {
+    const size_t i = (size_t(y) * size_t(width) + size_t(x)) * 3;
+    rgb[i] = c.x;
+    rgb[i + 1] = c.y;
+    rgb[i + 2] = c.z;
+  }
+};
+
+class Film {
+ public:
+  Film(int width, int height);
+
+  // Not thread-safe per pixel; the renderer gives every pixel to exactly one task.
+  void addSample(int x, int y, const Color& L) {
+    const size_t i = size_t(y) * size_t(width_) + size_t(x);
+    const glm::dvec3 d(L);
+    sum_[i] += d;
+    sumSq_[i] += d * d;
+    ++count_[i];
+  }
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  Image mean() const;
+  // Variance of each pixel's mean: sample variance / n (unbiased, n - 1 in the denominator).
+  Image varianceOfMean() const;
+
+ private:
+  int width_, height_;
+  std::vector<glm::dvec3> sum_, sumSq_;
+  std::vector<uint32_t> count_;
+};
+
+}  // namespace ember

@@ -1,0 +1,76 @@
+// Lights, behind one interface that next-event estimation samples and MIS queries:
+//   PointLight        isotropic radiant intensity I [W/sr per channel]: irradiance I cos / d^2.
+//   AreaLight         a shape with constant one-sided radiance L on the side of its normal.
+//   EnvironmentLight  constant radiance arriving from every direction (the scene "background").
+#pragma once
+
+#include "accel/shape.h"
+
+namespace ember {
+
+struct LightSample {
+  Vec3 wi;               // unit direction from the reference point towards the light
+  Vec3 p;                // the sampled point (unused for infinite lights)
+  float dist = kInfinity;
+  Color Li{0.0f};        // radiance (or, for delta lights, intensity / d^2) arriving at the ref
+  float pdf = 0.0f;      // solid-angle density of wi; 1 for delta lights
+  bool delta = false;
+};
+
+class Light {
+ public:
+  virtual ~Light() = default;
+  virtual bool sample(const Vec3& ref, Vec2 u, LightSample& out) const = 0;
+  // Solid-angle density with which sample() from ref yields the point p with normal n.
+  virtual float pdf(const Vec3& ref, const Vec3& p, const Vec3& n) const = 0;
+  // Total emitted power, used to choose among lights; sceneRadius bounds infinite lights.
+  virtual Color power(float sceneRadius) const = 0;
+  virtual bool isDelta() const { return false; }
+
+  int samplerIndex = -1;  // position in the LightSampler's table
+};
+
+class PointLight final : public Light {
+ public:
+  PointLight(const Vec3& position, const Color& intensity) : position_(position), intensity_(intensity) {}
+  bool sample(const Vec3& ref, Vec2 u, LightSample& out) const override;
+  float pdf(const Vec3&, const Vec3&, const Vec3&) const override { return 0.0f; }
+  Color power(float) const override { return 4.0f * kPi * intensity_; }
+  bool isDelta() const override { return true; }
+
+ private:
+  Vec3 position_;
+  Color intensity_;
+};
+
+class AreaLight final : public Light {
+ public:
+  AreaLight(const Shape* shape, const Color& radiance) : shape_(shape), radiance_(radiance) {}
+  bool sample(const Vec3& ref, Vec2 u, LightSample& out) const override;
+  float pdf(const Vec3& ref, const Vec3& p, const Vec3& n) const override {
+    return shape_->pdfSolidAngle(ref, p, n);
+  }
+  // One-sided Lambertian emitter: Phi = pi * A * L.
+  Color power(float) const override { return kPi * shape_->area() * radiance_; }
+
+ private:
+  const Shape* shape_;
+  Color radiance_;
+};
+
+class EnvironmentLight final : public Light {
+ public:
+  explicit EnvironmentLight(const Color& radiance) : radiance_(radiance) {}
+  bool sample(const Vec3& ref, Vec2 u, LightSample& out) const override;
+  float pdf(const Vec3&, const Vec3&, const Vec3&) const override;
+  // Power through a disc of the scene's radius from every direction (PBRT4 section 12.5.1).
+  Color power(float sceneRadius) const override {
+    return 4.0f * kPi * kPi * sceneRadius * sceneRadius * radiance_;
+  }
+  Color radiance(const Vec3& /*dir*/) const { return radiance_; }
+
+ private:
+  Color radiance_;
+};
+
+}  // namespace ember

@@ -1,0 +1,90 @@
+#include "renderer/path_integrator.h"
+
+#include "renderer/sampling.h"
+
+namespace ember {
+
+Color PathIntegrator::sampleLight(const Scene& scene, const SurfaceHit& hit, const Vec3& wo,
+                                  Rng& rng, PathStats& stats) const {
+  float pick;
+  const Light* light = scene.lightSampler().sample(rng.uniform(), pick);
+  const Vec2 u(rng.uniform(), rng.uniform());
+  LightSample ls;
+  if (!light || !light->sample(hit.p, u, ls) || ls.pdf <= 0.0f || isBlack(ls.Li)) return Color(0.0f);
+  const Color f = hit.material->eval(hit, wo, ls.wi);
+  if (isBlack(f)) return Color(0.0f);
+
+  const Vec3 origin = offsetRayOrigin(hit.p, hit.ng, ls.wi);
+  float dist = kInfinity;
+  if (std::isfinite(ls.dist)) {
+    // Stop short of the light's surface so the light itself does not count as a blocker.
+    dist = glm::length(ls.p - origin) * (1.0f - 1e-4f);
+  }
+  ++stats.shadowRays;
+  if (scene.occluded(origin, ls.wi, dist)) return Color(0.0f);
+
+  const float lightPdf = pick * ls.pdf;
+  const float weight = ls.delta ? 1.0f : powerHeuristic(lightPdf, hit.material->pdf(hit, wo, ls.wi));
+  return f * ls.Li * (weight / lightPdf);
+}
+
+Color PathIntegrator::Li(const Scene& scene, Ray ray, Rng& rng, PathStats& stats) const {
+  Color radiance(0.0f);
+  Color throughput(1.0f);
+  float etaProduct = 1.0f;
+  bool previousDelta = true;  // camera rays count as specular: emitters they see get weight 1
+  float previousPdf = 0.0f;
+  Vec3 previousPoint = ray.origin;
+  const LightSampler& lights = scene.lightSampler();
+
+  for (int depth = 1;; ++depth) {
+    SurfaceHit hit;
+    ++stats.rays;
+    if (!scene.intersect(ray, hit)) {
+      if (const EnvironmentLight* env = scene.environment()) {
+        float weight = 1.0f;
+        if (!previousDelta)
+          weight = powerHeuristic(previousPdf, lights.pmf(env) * env->pdf(previousPoint, ray.dir, ray.dir));
+        radiance += throughput * env->radiance(ray.dir) * weight;
+      }
+      break;
+    }
+    ++stats.vertices;
+    const Vec3 wo = -ray.dir;
+
+    const Color emitted = hit.emitted(wo);
+    if (!isBlack(emitted)) {
+      float weight = 1.0f;
+      if (!previousDelta && hit.light) {
+        const float lightPdf = lights.pmf(hit.light) * hit.light->pdf(previousPoint, hit.p, hit.ng);
+        weight = powerHeuristic(previousPdf, lightPdf);
+      }
+      radiance += throughput * emitted * weight;
+    }
+
+    if ((maxDepth_ >= 0 && depth >= maxDepth_) || !hit.material) break;
+
+    if (hit.material->hasNonDeltaLobes() && !lights.empty())
+      radiance += throughput * sampleLight(scene, hit, wo, rng, stats);
+
+    BsdfSample bs;
+    const Vec2 u(rng.uniform(), rng.uniform());
+    if (!hit.material->sample(hit, wo, u, rng.uniform(), bs)) break;
+    throughput *= bs.weight;
+    if (isBlack(throughput)) break;
+    previousDelta = bs.delta;
+    previousPdf = bs.pdf;
+    previousPoint = hit.p;
+    etaProduct *= bs.eta;
+    ray = Ray{offsetRayOrigin(hit.p, hit.ng, bs.wi), bs.wi};
+
+    if (depth >= rrDepth_) {
+      const float q = std::min(maxComponent(throughput) * etaProduct * etaProduct, 0.95f);
+      if (rng.uniform() >= q) break;
+      throughput /= q;
+    }
+  }
+  return radiance;
+}
+
+}  // namespace ember

@@ -1,0 +1,86 @@
+#include "renderer/scene.h"
+
+namespace ember {
+
+const Material* Scene::addMaterial(std::string name, std::unique_ptr<Material> material) {
+  materials.push_back(std::move(material));
+  materialNames.push_back(std::move(name));
+  return materials.back().get();
+}
+
+void Scene::build() {
+  accel_ = std::make_unique<EmbreeAccel>();
+  records_.clear();
+  std::vector<Light*> allLights;
+  for (auto& light : lights) allLights.push_back(light.get());
+
+  for (ShapeEntry& entry : shapes) {
+    const uint32_t id = accel_->addShape(entry.shape.get());
+    GeometryRecord rec{entry.shape.get(), nullptr, entry.material, nullptr, entry.emission};
+    if (!isBlack(entry.emission)) {
+      lights.push_back(std::make_unique<AreaLight>(entry.shape.get(), entry.emission));
+      allLights.push_back(lights.back().get());
+      rec.light = lights.back().get();
+    }
+    if (records_.size() <= id) records_.resize(id + 1);
+    records_[id] = rec;
+  }
+  for (MeshEntry& entry : meshes) {
+    if (entry.mesh->indices.empty()) continue;
+    const uint32_t id = accel_->addMesh(entry.mesh.get());
+    if (records_.size() <= id) records_.resize(id + 1);
+    // Emissive meshes are found by BSDF sampling; they are not (yet) sampled as lights.
+    records_[id] = GeometryRecord{nullptr, entry.mesh.get(), entry.material, nullptr, entry.emission};
+  }
+  accel_->commit();
+  bounds_ = accel_->bounds();
+  if (bounds_.empty()) {
+    bounds_.extend(Vec3(-1.0f));
+    bounds_.extend(Vec3(1.0f));
+  }
+
+  if (!isBlack(background)) {
+    lights.push_back(std::make_unique<EnvironmentLight>(background));
+    environment_ = static_cast<const EnvironmentLight*>(lights.back().get());
+    allLights.push_back(lights.back().get());
+  }
+  const float radius = 0.5f * glm::length(bounds_.upper - bounds_.lower);
+  lightSampler_ = LightSampler(allLights, radius);
+  camera_ = PinholeCamera(cameraParams, settings.width, settings.height);
+}
+
+bool Scene::intersect(const Ray& ray, SurfaceHit& hit) const {
+  RawHit raw;
+  if (!accel_->intersect(ray, raw)) return false;
+  const GeometryRecord& rec = records_[raw.geomID];
+  hit.t = raw.t;
+  hit.p = ray.origin + raw.t * ray.dir;
+  if (rec.shape) {
+    hit.ng = raw.ng;
+    hit.uv = raw.uv;
+    LocalHit local{raw.t, raw.ng, raw.uv};
+    hit.ns = rec.shape->shadingNormal(hit.p, local);
+  } else {
+    const TriangleMesh::Surface s = rec.mesh->surfaceAt(raw.primID, raw.uv.x, raw.uv.y);
+    hit.ng = s.ng;
+    hit.uv = s.uv;
+    // Keep the shading normal in the geometric normal's hemisphere.
+    hit.ns = glm::dot(s.ns, s.ng) < 0.0f ? -s.ns : s.ns;
+  }
+  hit.material = rec.material;
+  hit.light = rec.light;
+  hit.emission = rec.emission;
+  return true;
+}
+
+bool Scene::occluded(const Vec3& from, const Vec3& dir, float dist) const {
+  return accel_->occluded(Ray{from, dir, dist});
+}
+
+size_t Scene::triangleCount() const {
+  size_t n = 0;
+  for (const MeshEntry& m : meshes) n += m.mesh->indices.size();
+  return n;
+}
+
+}  // namespace ember

@@ -1,0 +1,87 @@
+// A renderable scene: what the loaders (io/) fill in, plus what build() derives from it — the
+// Embree acceleration structure, one area light per emitting shape and the light sampler.
+#pragma once
+
+#include "accel/embree_accel.h"
+#include "materials/material.h"
+#include "renderer/camera.h"
+#include "renderer/light.h"
+#include "renderer/light_sampler.h"
+#include "renderer/surface_hit.h"
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace ember {
+
+struct RenderSettings {
+  int width = 256;
+  int height = 256;
+  int spp = 64;
+  int maxDepth = -1;  // longest path in segments; -1 = unbounded (Russian roulette ends paths)
+  int rrDepth = 5;    // Russian roulette starts after this many segments
+  uint64_t seed = 0;
+};
+
+class Scene {
+ public:
+  struct ShapeEntry {
+    std::string name;
+    std::unique_ptr<Shape> shape;
+    const Material* material = nullptr;
+    Color emission{0.0f};
+  };
+  struct MeshEntry {
+    std::unique_ptr<TriangleMesh> mesh;
+    const Material* material = nullptr;
+    Color emission{0.0f};
+  };
+
+  // --- filled in by a loader --------------------------------------------------------------
+  std::string sourcePath;
+  RenderSettings settings;
+  CameraParams cameraParams;
+  Color background{0.0f};  // constant environment radiance; black = none
+  std::vector<std::unique_ptr<Material>> materials;
+  std::vector<std::string> materialNames;  // parallel to materials
+  std::vector<ShapeEntry> shapes;
+  std::vector<MeshEntry> meshes;
+  std::vector<std::unique_ptr<Light>> lights;  // point lights; build() appends the derived ones
+
+  const Material* addMaterial(std::string name, std::unique_ptr<Material> material);
+
+  // --- derived by build() -------------------------------------------------------------------
+  void build();
+  bool built() const { return accel_ != nullptr; }
+
+  bool intersect(const Ray& ray, SurfaceHit& hit) const;
+  // True when something blocks the segment from `from` (already offset) to `to`.
+  bool occluded(const Vec3& from, const Vec3& dir, float dist) const;
+
+  const PinholeCamera& camera() const { return camera_; }
+  const LightSampler& lightSampler() const { return lightSampler_; }
+  const EnvironmentLight* environment() const { return environment_; }
+  Bounds bounds() const { return bounds_; }
+  const EmbreeAccel& accel() const { return *accel_; }
+  size_t triangleCount() const;
+
+ private:
+  struct GeometryRecord {
+    const Shape* shape = nullptr;
+    const TriangleMesh* mesh = nullptr;
+    const Material* material = nullptr;
+    const Light* light = nullptr;
+    Color emission{0.0f};
+  };
+
+  std::unique_ptr<EmbreeAccel> accel_;
+  std::vector<GeometryRecord> records_;  // indexed by Embree geomID
+  PinholeCamera camera_;
+  LightSampler lightSampler_;
+  const EnvironmentLight* environment_ = nullptr;
+  Bounds bounds_;
+};
+
+}  // namespace ember
