@@ -1,6 +1,6 @@
 // The interface every analytic shape implements. Shapes are exact (no tessellation): Embree calls
 // them through user-geometry callbacks (accel/user_geometry.cpp), and lights sample them
-// (renderer/area_light.cpp). A closed shape's normal points outwards; an open shape's normal is its
+// (AreaLight in renderer/light.cpp). A closed shape's normal points outwards; an open shape's normal is its
 // "front" side, the side an emitting shape emits on.
 #pragma once
 

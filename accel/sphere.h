@@ -1,4 +1,4 @@
-// Sphere: exact quadric. UV: u = longitude / (2 pi) measured from +z towards +x (u = 0.5 on +z),
+// Sphere: exact quadric. UV: u = 0.5 + atan2(n.x, n.z) / (2 pi) (u = 0.5 on +z, growing towards +x),
 // v = polar angle / pi from the +y pole (v = 0 at the top). Lights sample the cone of directions
 // the sphere subtends (PBRT4 section 6.2.4), which has far less variance than area sampling.
 #pragma once

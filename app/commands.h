@@ -13,5 +13,7 @@ using Runner = std::function<int()>;
 Runner addRenderCommand(CLI::App& app);
 Runner addTonemapCommand(CLI::App& app);
 Runner addInfoCommand(CLI::App& app);
+Runner addBenchCommand(CLI::App& app);
+Runner addCompareCommand(CLI::App& app);
 
 }  // namespace ember::cli

@@ -21,6 +21,9 @@ Runner addInfoCommand(CLI::App& app) {
       ++byType[std::string(s.shape->typeName())];
       emitters += !isBlack(s.emission);
     }
+    size_t emissiveTriangles = 0;
+    for (const auto& m : scene.meshes)
+      if (!isBlack(m.emission)) emissiveTriangles += m.mesh->indices.size();
     const RenderSettings& rs = scene.settings;
     const CameraParams& c = scene.cameraParams;
     const Bounds b = scene.bounds();
@@ -32,8 +35,8 @@ Runner addInfoCommand(CLI::App& app) {
     std::printf("shapes:     %zu", scene.shapes.size());
     for (const auto& [type, n] : byType) std::printf("  %s %d", type.c_str(), n);
     std::printf("\nmeshes:     %zu (%zu triangles)\n", scene.meshes.size(), scene.triangleCount());
-    std::printf("lights:     %zu point, %d area, %s environment\n", pointLights, emitters,
-                scene.environment() ? "1" : "no");
+    std::printf("lights:     %zu point, %d area, %zu emissive triangles, %s environment\n", pointLights, emitters,
+                emissiveTriangles, scene.environment() ? "1" : "no");
     std::printf("materials:  %zu", scene.materials.size());
     for (size_t i = 0; i < scene.materials.size(); ++i)
       std::printf("%s %s (%s)", i ? "," : "", scene.materialNames[i].c_str(),

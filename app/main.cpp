@@ -1,4 +1,4 @@
-// ember: command-line front end. Subcommands live in one file each (render, tonemap, info).
+// ember: command-line front end. Subcommands live in one file each (render, tonemap, info, bench, compare).
 #include "app/commands.h"
 
 #include "io/input_error.h"
@@ -12,12 +12,19 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("ember ") + EMBER_VERSION);
   app.require_subcommand(1);
   std::map<CLI::App*, ember::cli::Runner> runners;
-  for (auto add : {ember::cli::addRenderCommand, ember::cli::addTonemapCommand, ember::cli::addInfoCommand}) {
+  for (auto add : {ember::cli::addRenderCommand, ember::cli::addTonemapCommand, ember::cli::addInfoCommand,
+                   ember::cli::addBenchCommand, ember::cli::addCompareCommand}) {
     const size_t before = app.get_subcommands({}).size();
     ember::cli::Runner run = add(app);
     runners[app.get_subcommands({})[before]] = std::move(run);
   }
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help and --version exit 0; any bad argument exits 2, as for bad input to `compare`.
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  }
   try {
     for (auto& [sub, run] : runners)
       if (sub->parsed()) return run();

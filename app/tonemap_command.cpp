@@ -23,7 +23,7 @@ Runner addTonemapCommand(CLI::App& app) {
   cmd->add_option("--white", args->white, "Input luminance that maps to white (default: the image's maximum)")->check(CLI::PositiveNumber);
   return [args] {
     const Image image = readImageRgb(args->input);
-    const ReinhardResult r = tonemapReinhard(image, ReinhardParams{args->key, args->white});
+    const ReinhardResult r = tonemapReinhard(image, ReinhardParams{args->key, args->white, std::nullopt});
     writePng(args->output, image.width, image.height, r.rgb8);
     std::fprintf(stderr, "ember: tonemap: log-average luminance %.6g, white %.6g -> %s\n", r.logAverage, r.white,
                  args->output.c_str());

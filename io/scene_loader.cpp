@@ -4,6 +4,7 @@
 #include "accel/cone.h"
 #include "accel/cylinder.h"
 #include "accel/disc.h"
+#include "accel/flipped_shape.h"
 #include "accel/sphere.h"
 #include "accel/triangle.h"
 #include "io/gltf_loader.h"
@@ -67,7 +68,8 @@ class JsonSceneLoader {
     if (c.fovYDeg >= 180.0f) n.at("fov_y_deg").fail("expected a number in (0, 180)");
     const Vec3 f = c.target - c.origin;
     if (glm::length(f) == 0.0f) n.at("target").fail("must differ from origin");
-    if (glm::length(glm::cross(glm::normalize(f), c.up)) < 1e-6f) n.at("up").fail("must not be parallel to the view direction");
+    if (glm::length(glm::cross(glm::normalize(f), c.up)) < 1e-6f)
+      (n.has("up") ? n.at("up") : n).fail("up must not be parallel to the view direction (the default up is +y)");
   }
 
   void readRender(const JsonNode& n) {
@@ -170,7 +172,7 @@ class JsonSceneLoader {
       return std::make_unique<Mixed>(std::move(c));
     }
     m.at("type").fail("unknown material type '" + type +
-                      "'; valid types are: diffuse, phong, mirror, refraction, dielectric, mixed");
+                      "'; valid types are: diffuse (alias lambertian), phong, mirror, refraction, dielectric, mixed");
   }
 
   const Material* materialFor(const JsonNode& s, bool emissive) {
@@ -205,7 +207,7 @@ class JsonSceneLoader {
     const std::string type = s.at("type").string();
     const Color emission = s.color("emission", Color(0.0f));
     auto common = [&](std::initializer_list<std::string_view> extra) {
-      std::vector<std::string_view> keys{"type", "id", "name", "material", "emission"};
+      std::vector<std::string_view> keys{"type", "id", "name", "material", "emission", "flip_normals"};
       keys.insert(keys.end(), extra.begin(), extra.end());
       checkKeys(s, keys);
     };
@@ -229,8 +231,8 @@ class JsonSceneLoader {
     } else if (type == "box") {
       common({"center", "size", "rotate_y_deg", "rotation"});
       const JsonNode size = s.at("size");
-      const Vec3 sz(size[0].positive(), size[1].positive(), size[2].positive());
       if (size.arraySize() != 3) size.fail("expected an array of 3 numbers > 0");
+      const Vec3 sz(size[0].positive(), size[1].positive(), size[2].positive());
       glm::mat3 rotation(1.0f);
       if (auto r = s.find("rotate_y_deg"))
         rotation = glm::mat3(glm::rotate(Mat4(1.0f), glm::radians(r->number()), Vec3(0.0f, 1.0f, 0.0f)));
@@ -244,20 +246,26 @@ class JsonSceneLoader {
       if (!(glm::length(glm::cross(v[1] - v[0], v[2] - v[0])) > 0.0f)) s.at("vertices").fail("degenerate triangle (zero area)");
       shape = std::make_unique<Triangle>(v, uv);
     } else if (type == "quad") {
-      common({"vertices", "uvs", "front_normal"});
+      common({"vertices", "uvs"});
       std::array<Vec3, 4> v = readPoints<4>(s.at("vertices"));
       std::array<Vec2, 4> uv{Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)};
       if (auto u = s.find("uvs")) uv = readUvs<4>(*u);
-      if (!(glm::length(glm::cross(v[1] - v[0], v[2] - v[0])) > 0.0f)) s.at("vertices").fail("degenerate quad (zero area)");
+      const Vec3 normal = glm::cross(v[1] - v[0], v[2] - v[0]);
+      if (!(glm::length(normal) > 0.0f)) s.at("vertices").fail("degenerate quad (zero area)");
+      const float size = glm::length(v[2] - v[0]);
+      if (std::abs(glm::dot(glm::normalize(normal), v[3] - v[0])) > 1e-4f * size)
+        s.at("vertices").fail("the four vertices of a quad must lie in one plane");
       shape = std::make_unique<Quad>(v, uv);
     } else if (type == "mesh") {
       common({"file", "transform"});
+      if (s.has("flip_normals")) s.at("flip_normals").fail("not supported for meshes");
       readMesh(s, emission);
       return;
     } else {
       s.at("type").fail("unknown shape type '" + type +
                         "'; valid types are: sphere, disc, cylinder, cone, box, triangle, quad, mesh");
     }
+    if (s.boolean("flip_normals", false)) shape = std::make_unique<FlippedShape>(std::move(shape));
     scene_.shapes.push_back({shapeName(s, type), std::move(shape), materialFor(s, !isBlack(emission)), emission});
   }
 
@@ -334,7 +342,7 @@ class JsonSceneLoader {
   void readLight(const JsonNode& l) {
     const std::string type = l.at("type").string();
     if (type != "point") l.at("type").fail("unknown light type '" + type + "'; valid types are: point");
-    l.allowKeys({"type", "id", "name", "position", "intensity", "intensity_unit"});
+    l.allowKeys({"type", "id", "name", "position", "intensity"});
     scene_.lights.push_back(std::make_unique<PointLight>(l.at("position").vec3(), l.at("intensity").color()));
   }
 

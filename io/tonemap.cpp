@@ -19,7 +19,7 @@ Image reinhardLinear(const Image& image, const ReinhardParams& params, float* lo
       maxLum = std::max(maxLum, lum);
       ++n;
     }
-  const float logAverage = n ? float(std::exp(logSum / double(n))) : 1.0f;
+  const float logAverage = params.logAverage.value_or(n ? float(std::exp(logSum / double(n))) : 1.0f);
   const float white = params.white.value_or(maxLum);
   const float scale = logAverage > 0.0f ? params.key / logAverage : 0.0f;
   const float whiteScaled = std::max(white * scale, 1e-20f);

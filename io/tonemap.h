@@ -18,6 +18,9 @@ namespace ember {
 struct ReinhardParams {
   float key = 0.18f;
   std::optional<float> white;  // input luminance mapped to white; default: the maximum
+  // Log-average luminance to use instead of the image's own, so two images (a render and its
+  // reference) can share one tone curve.
+  std::optional<float> logAverage;
 };
 
 struct ReinhardResult {

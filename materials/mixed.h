@@ -2,9 +2,10 @@
 // perfect refraction part kt (index `ior` inside). At each scattering event one part is chosen by
 // Russian roulette with probability equal to its coefficient's largest channel; the remainder,
 // 1 - sum of those maxima, absorbs the path. The loader checks that the probabilities sum to <= 1
-// and that kd + ks + kr + kt <= 1 per channel (energy conservation).
-// The diffuse and glossy parts together form the non-delta part that light sampling sees: eval and
-// pdf return their sum, weighted by their selection probabilities, so MIS stays consistent.
+// (which implies kd + ks + kr + kt <= 1 per channel: energy conservation).
+// The diffuse and glossy parts together form the non-delta part that light sampling sees: eval
+// returns their BRDF sum, pdf their sampling densities weighted by their selection probabilities,
+// so MIS between light and BSDF sampling stays consistent.
 #pragma once
 
 #include "materials/material.h"

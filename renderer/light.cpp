@@ -33,6 +33,23 @@ bool AreaLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
   return true;
 }
 
+bool TriangleLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
+  const Vec2 b = sampleUniformTriangle(u);
+  const TriangleMesh::Surface surface = mesh_->surfaceAt(prim_, b.y, 1.0f - b.x - b.y);
+  const glm::uvec3& idx = mesh_->indices[prim_];
+  const Vec3 p = b.x * mesh_->positions[idx.x] + b.y * mesh_->positions[idx.y] +
+                 (1.0f - b.x - b.y) * mesh_->positions[idx.z];
+  const Vec3 d = p - ref;
+  out.dist = glm::length(d);
+  if (out.dist == 0.0f) return false;
+  out.wi = d / out.dist;
+  out.p = p;
+  out.pdf = pdf(ref, p, surface.ng);
+  out.delta = false;
+  out.Li = glm::dot(-out.wi, surface.ng) > 0.0f ? radiance_ : Color(0.0f);
+  return out.pdf > 0.0f && std::isfinite(out.pdf);
+}
+
 bool EnvironmentLight::sample(const Vec3&, Vec2 u, LightSample& out) const {
   out.wi = sampleUniformSphere(u);
   out.dist = kInfinity;

@@ -1,10 +1,12 @@
 // Lights, behind one interface that next-event estimation samples and MIS queries:
 //   PointLight        isotropic radiant intensity I [W/sr per channel]: irradiance I cos / d^2.
 //   AreaLight         a shape with constant one-sided radiance L on the side of its normal.
+//   TriangleLight     one triangle of an emissive mesh (glTF emissiveFactor), sampled by area.
 //   EnvironmentLight  constant radiance arriving from every direction (the scene "background").
 #pragma once
 
 #include "accel/shape.h"
+#include "accel/triangle_mesh.h"
 
 namespace ember {
 
@@ -55,6 +57,22 @@ class AreaLight final : public Light {
 
  private:
   const Shape* shape_;
+  Color radiance_;
+};
+
+class TriangleLight final : public Light {
+ public:
+  TriangleLight(const TriangleMesh* mesh, uint32_t prim, const Color& radiance)
+      : mesh_(mesh), prim_(prim), radiance_(radiance) {}
+  bool sample(const Vec3& ref, Vec2 u, LightSample& out) const override;
+  float pdf(const Vec3& ref, const Vec3& p, const Vec3& n) const override {
+    return areaToSolidAnglePdf(1.0f / mesh_->triangleArea(prim_), ref, p, n);
+  }
+  Color power(float) const override { return kPi * mesh_->triangleArea(prim_) * radiance_; }
+
+ private:
+  const TriangleMesh* mesh_;
+  uint32_t prim_;
   Color radiance_;
 };
 

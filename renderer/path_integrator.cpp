@@ -36,6 +36,7 @@ Color PathIntegrator::Li(const Scene& scene, Ray ray, Rng& rng, PathStats& stats
   float previousPdf = 0.0f;
   Vec3 previousPoint = ray.origin;
   const LightSampler& lights = scene.lightSampler();
+  if (maxDepth_ == 0) return radiance;  // paths of zero segments carry no light (as in Mitsuba)
 
   for (int depth = 1;; ++depth) {
     SurfaceHit hit;

@@ -9,8 +9,13 @@ const Material* Scene::addMaterial(std::string name, std::unique_ptr<Material> m
 }
 
 void Scene::build() {
+  // Building again (after editing the scene) first drops the lights the last build derived.
+  if (accel_) lights.resize(loadedLightCount_);
+  loadedLightCount_ = lights.size();
+  environment_ = nullptr;
   accel_ = std::make_unique<EmbreeAccel>();
   records_.clear();
+  triangleLights_.clear();
   std::vector<Light*> allLights;
   for (auto& light : lights) allLights.push_back(light.get());
 
@@ -29,8 +34,17 @@ void Scene::build() {
     if (entry.mesh->indices.empty()) continue;
     const uint32_t id = accel_->addMesh(entry.mesh.get());
     if (records_.size() <= id) records_.resize(id + 1);
-    // Emissive meshes are found by BSDF sampling; they are not (yet) sampled as lights.
-    records_[id] = GeometryRecord{nullptr, entry.mesh.get(), entry.material, nullptr, entry.emission};
+    GeometryRecord rec{nullptr, entry.mesh.get(), entry.material, nullptr, entry.emission};
+    if (!isBlack(entry.emission)) {
+      // Every triangle of an emissive mesh is a light of its own, chosen by power like the rest.
+      rec.firstTriangleLight = int64_t(triangleLights_.size());
+      for (uint32_t prim = 0; prim < entry.mesh->indices.size(); ++prim) {
+        lights.push_back(std::make_unique<TriangleLight>(entry.mesh.get(), prim, entry.emission));
+        allLights.push_back(lights.back().get());
+        triangleLights_.push_back(lights.back().get());
+      }
+    }
+    records_[id] = rec;
   }
   accel_->commit();
   bounds_ = accel_->bounds();
@@ -68,7 +82,7 @@ bool Scene::intersect(const Ray& ray, SurfaceHit& hit) const {
     hit.ns = glm::dot(s.ns, s.ng) < 0.0f ? -s.ns : s.ns;
   }
   hit.material = rec.material;
-  hit.light = rec.light;
+  hit.light = rec.firstTriangleLight >= 0 ? triangleLights_[size_t(rec.firstTriangleLight) + raw.primID] : rec.light;
   hit.emission = rec.emission;
   return true;
 }

@@ -74,9 +74,12 @@ class Scene {
     const Material* material = nullptr;
     const Light* light = nullptr;
     Color emission{0.0f};
+    int64_t firstTriangleLight = -1;  // emissive meshes: index of primitive 0's light in triangleLights_
   };
 
   std::unique_ptr<EmbreeAccel> accel_;
+  std::vector<const Light*> triangleLights_;
+  size_t loadedLightCount_ = 0;
   std::vector<GeometryRecord> records_;  // indexed by Embree geomID
   PinholeCamera camera_;
   LightSampler lightSampler_;

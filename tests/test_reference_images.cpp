@@ -7,8 +7,10 @@
 // The power tests change the scene slightly (a brighter light, swapped wall colours, a moved
 // sphere) and require the same comparison to fail.
 #include "accel/sphere.h"
+#include "materials/lambertian.h"
 #include "io/image_compare.h"
 #include "io/image_io.h"
+#include "io/image_metrics.h"
 #include "io/scene_loader.h"
 #include "renderer/path_integrator.h"
 #include "renderer/render.h"
@@ -85,6 +87,15 @@ TEST_P(ReferenceImage, MatchesMitsubaWithinNoise) {
   const BlockZTestResult r = blockZTest(both.mean, both.variance, ref.mean, ref.variance, kBlock, kAlpha);
   EXPECT_TRUE(r.passes()) << name << " vs reference: " << describe(r);
   std::printf("[ %s ] %s\n", name.c_str(), describe(r).c_str());
+
+  // Every pixel and channel on its own (as `ember compare --variance --ref-stderr` does).
+  Image refStderr = ref.variance;
+  for (float& v : refStderr.rgb) v = std::sqrt(v);
+  const PixelZTest z = pixelZTest(both.mean, both.variance, ref.mean, refStderr, kAlpha);
+  EXPECT_TRUE(z.passed()) << name << ": " << z.rejected << " of " << z.tests << " pixel-channels beyond |z| > "
+                          << z.threshold << ", max |z| " << z.maxAbsZ;
+  std::printf("[ %s ] per-pixel z-test: %zu of %zu rejected (|z| > %.3f), max |z| %.3f\n", name.c_str(),
+              z.rejected, z.tests, z.threshold, z.maxAbsZ);
 }
 
 INSTANTIATE_TEST_SUITE_P(SharedScenes, ReferenceImage,
@@ -131,6 +142,27 @@ TEST(ReferenceImagePower, FailsWhenASphereMoves) {
     auto& sphere = shapeNamed(s, "sphere");
     const auto* old = static_cast<const Sphere*>(sphere.shape.get());
     sphere.shape = std::make_unique<Sphere>(old->center() + Vec3(0.03f, 0.0f, 0.0f), old->radius());
+  });
+  EXPECT_FALSE(r.passes()) << describe(r);
+}
+
+TEST(ReferenceImagePower, FailsWhenTheAreaLightIsTwoPercentBrighter) {
+  const auto r = compareMutated("cornell-area", [](Scene& s) { shapeNamed(s, "light").emission *= 1.02f; });
+  EXPECT_FALSE(r.passes()) << describe(r);
+}
+
+TEST(ReferenceImagePower, FailsWhenThePointLightIsTwoPercentBrighter) {
+  const auto r = compareMutated("cornell-point", [](Scene& s) {
+    ASSERT_EQ(s.lights.size(), 1u);
+    s.lights[0] = std::make_unique<PointLight>(Vec3(0.0f, 1.7f, 0.0f), Color(3.0f * 1.02f));
+  });
+  EXPECT_FALSE(r.passes()) << describe(r);
+}
+
+TEST(ReferenceImagePower, FailsWhenTheWhiteAlbedoChangesByOnePercent) {
+  const auto r = compareMutated("shapes", [](Scene& s) {
+    const Material* whiter = s.addMaterial("whiter", std::make_unique<Lambertian>(std::make_shared<ConstantTexture>(Color(0.75f * 1.01f))));
+    for (const char* wall : {"floor", "ceiling", "back_wall"}) shapeNamed(s, wall).material = whiter;
   });
   EXPECT_FALSE(r.passes()) << describe(r);
 }

@@ -62,7 +62,7 @@ TEST(SceneParser, BadInputNamesFileAndPath) {
       {"negative radius", variant("\"radius\": 0.5", "\"radius\": -0.5"), "shapes[3].radius: expected a number > 0"},
       {"radius as string", variant("\"radius\": 0.5", "\"radius\": \"big\""), "shapes[3].radius: expected a number > 0"},
       {"unknown shape key", variant("\"radius\": 0.5", "\"radius\": 0.5, \"colour\": 1"),
-       "shapes[3].colour: unknown key; valid keys for this shape are: type, id, name, material, emission, center, radius"},
+       "shapes[3].colour: unknown key; valid keys for this shape are: type, id, name, material, emission, flip_normals, center, radius"},
       {"unknown top-level key", variant("\"render\"", "\"rendr\""), "rendr: unknown key; valid keys here are: image, camera, render"},
       {"unknown material", variant("\"material\": \"white\"}", "\"material\": \"snow\"}"),
        "shapes[0].material: unknown material 'snow'; defined materials are: white"},
@@ -127,7 +127,7 @@ TEST(CommandLine, RenderWritesExrAndPngAndInfoDescribesScene) {
   const auto info = test::runEmber("info '" + scene + "'");
   ASSERT_EQ(info.exitCode, 0) << info.output;
   EXPECT_NE(info.output.find("shapes:     4  disc 1  quad 1  sphere 2"), std::string::npos) << info.output;
-  EXPECT_NE(info.output.find("1 point, 1 area"), std::string::npos) << info.output;
+  EXPECT_NE(info.output.find("1 point, 1 area, 0 emissive triangles"), std::string::npos) << info.output;
 
   const auto tm = test::runEmber("tonemap '" + dir.file("a.exr") + "' -o '" + dir.file("b.png") + "' --key 0.3");
   EXPECT_EQ(tm.exitCode, 0) << tm.output;

@@ -32,7 +32,7 @@ TEST(Tonemap, KeyAndWhiteAreHonoured) {
   img.set(0, 0, Color(1.0f));
   img.set(1, 0, Color(4.0f));
   // key 0.36 doubles the scale; white = 8 (input units) -> 1.44 scaled.
-  const Image out = reinhardLinear(img, ReinhardParams{0.36f, 8.0f});
+  const Image out = reinhardLinear(img, ReinhardParams{0.36f, 8.0f, std::nullopt});
   const float L = 0.72f, w2 = 1.44f * 1.44f;
   EXPECT_NEAR(out.at(1, 0).x, L * (1.0f + L / w2) / (1.0f + L), 1e-5f);
 }

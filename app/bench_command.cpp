@@ -1,0 +1,141 @@
+// `ember bench`: load, build and render scenes K times and report throughput. Measures only; the
+// test suite never times anything. The JSON layout is documented in docs/performance.md.
+#include "app/commands.h"
+
+#include "io/input_error.h"
+#include "io/scene_loader.h"
+#include "renderer/path_integrator.h"
+#include "renderer/render.h"
+
+#include <nlohmann/json.hpp>
+#include <sys/resource.h>
+#include <tbb/info.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <optional>
+
+namespace ember::cli {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+std::string cpuModel() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
+  return "unknown";
+}
+
+double peakResidentMb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return double(usage.ru_maxrss) / 1024.0;  // Linux reports kilobytes
+}
+
+struct BenchArgs {
+  std::vector<std::string> scenes;
+  std::optional<int> spp;
+  int threads = 0;
+  int repeat = 3;
+  std::string json;
+};
+
+int runBench(const BenchArgs& a) {
+  std::vector<std::string> scenes = a.scenes;
+  if (scenes.empty())
+    for (const char* s : {"cornell-area", "cornell-point", "shapes", "textured"})
+      scenes.push_back(std::string("scenes/") + s + ".json");
+
+  nlohmann::json report;
+  report["ember_version"] = EMBER_VERSION;
+  report["build"] = {{"type", EMBER_BUILD_TYPE}, {"cxx_flags", EMBER_CXX_FLAGS}, {"compiler", EMBER_COMPILER}};
+  report["machine"] = {{"cpu", cpuModel()}, {"cores", tbb::info::default_concurrency()}};
+  report["threads"] = a.threads > 0 ? a.threads : tbb::info::default_concurrency();
+  report["repeat"] = a.repeat;
+  report["scenes"] = nlohmann::json::array();
+
+  std::printf("%-22s %7s %5s %8s %8s %9s %10s %10s %10s %10s %9s %8s\n", "scene", "spp", "thr", "load s",
+              "build s", "render s", "Msamples/s", "Mverts/s", "Mrays/s", "Mshadow/s", "nonfinite", "peak MB");
+  for (const std::string& path : scenes) {
+    const auto loadStart = Clock::now();
+    Scene scene = loadScene(path);
+    const double loadSeconds = secondsSince(loadStart);
+    if (a.spp) scene.settings.spp = *a.spp;
+    const auto buildStart = Clock::now();
+    scene.build();
+    const double buildSeconds = secondsSince(buildStart);
+    report["machine"]["isa"] = scene.accel().isaName();
+
+    const PathIntegrator integrator(scene.settings.maxDepth, scene.settings.rrDepth);
+    RenderOptions options;
+    options.spp = scene.settings.spp;
+    options.seed = scene.settings.seed;
+    options.threads = a.threads;
+    std::vector<RenderStats> runs;
+    for (int k = 0; k < a.repeat; ++k) {
+      Film film(scene.settings.width, scene.settings.height);
+      runs.push_back(render(scene, integrator, options, film));
+    }
+    std::sort(runs.begin(), runs.end(), [](const RenderStats& x, const RenderStats& y) { return x.seconds < y.seconds; });
+    const RenderStats& med = runs[runs.size() / 2];
+    const double s = std::max(med.seconds, 1e-9);
+    nlohmann::json row = {
+        {"scene", path},
+        {"width", scene.settings.width},
+        {"height", scene.settings.height},
+        {"spp", options.spp},
+        {"threads", med.threads},
+        {"load_seconds", loadSeconds},
+        {"build_seconds", buildSeconds},
+        {"render_seconds_median", med.seconds},
+        {"render_seconds_all", nlohmann::json::array()},
+        {"samples_per_second", double(med.samples) / s},
+        {"path_vertices_per_second", double(med.paths.vertices) / s},
+        {"closest_hit_rays_per_second", double(med.paths.rays) / s},
+        {"shadow_rays_per_second", double(med.paths.shadowRays) / s},
+        {"rays_per_second", double(med.paths.rays + med.paths.shadowRays) / s},
+        {"nonfinite_samples", med.nonFinite},
+        {"peak_resident_mb", peakResidentMb()},
+    };
+    for (const RenderStats& r : runs) row["render_seconds_all"].push_back(r.seconds);
+    report["scenes"].push_back(row);
+    std::printf("%-22s %7d %5d %8.3f %8.3f %9.3f %10.3f %10.3f %10.3f %10.3f %9llu %8.1f\n",
+                std::filesystem::path(path).stem().string().c_str(), options.spp, med.threads, loadSeconds,
+                buildSeconds, med.seconds, double(med.samples) / s * 1e-6, double(med.paths.vertices) / s * 1e-6,
+                double(med.paths.rays + med.paths.shadowRays) / s * 1e-6, double(med.paths.shadowRays) / s * 1e-6,
+                static_cast<unsigned long long>(med.nonFinite), peakResidentMb());
+    std::fflush(stdout);
+  }
+  std::printf("machine: %s, %d cores, Embree ISA %s; ember %s (%s)\n", cpuModel().c_str(),
+              tbb::info::default_concurrency(), report["machine"].value("isa", "?").c_str(), EMBER_VERSION,
+              EMBER_BUILD_TYPE);
+  if (!a.json.empty()) {
+    std::ofstream out(a.json);
+    if (!out) throw InputError(a.json + ": cannot write");
+    out << report.dump(2) << "\n";
+  }
+  return 0;
+}
+
+}  // namespace
+
+Runner addBenchCommand(CLI::App& app) {
+  auto args = std::make_shared<BenchArgs>();
+  CLI::App* cmd = app.add_subcommand("bench", "Measure load, build and render throughput (samples/s, rays/s) on scenes");
+  cmd->add_option("scenes", args->scenes, "Scene files (default: the four shared scenes in scenes/)");
+  cmd->add_option("--spp", args->spp, "Samples per pixel (default: each scene's own)")->check(CLI::Range(1, 1 << 24));
+  cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 4096));
+  cmd->add_option("--repeat", args->repeat, "Renders per scene; the median is reported (default 3)")->check(CLI::Range(1, 1000));
+  cmd->add_option("--json", args->json, "Also write the results as JSON (layout: docs/performance.md)");
+  return [args] { return runBench(*args); };
+}
+
+}  // namespace ember::cli
