@@ -14,7 +14,7 @@ Color PathIntegrator::sampleLight(const Scene& scene, const SurfaceHit& hit, con
   const Color f = hit.material->eval(hit, wo, ls.wi);
   if (isBlack(f)) return Color(0.0f);
 
-  const Vec3 origin = offsetRayOrigin(hit.p, hit.ng, ls.wi);
+  const Vec3 origin = offsetRayOrigin(hit.p, hit.ng, ls.wi, hit.t);
   float dist = kInfinity;
   if (std::isfinite(ls.dist)) {
     // Stop short of the light's surface so the light itself does not count as a blocker.
@@ -77,7 +77,7 @@ Color PathIntegrator::Li(const Scene& scene, Ray ray, Rng& rng, PathStats& stats
     previousPdf = bs.pdf;
     previousPoint = hit.p;
     etaProduct *= bs.eta;
-    ray = Ray{offsetRayOrigin(hit.p, hit.ng, bs.wi), bs.wi};
+    ray = Ray{offsetRayOrigin(hit.p, hit.ng, bs.wi, hit.t), bs.wi};
 
     if (depth >= rrDepth_) {
       const float q = std::min(maxComponent(throughput) * etaProduct * etaProduct, 0.95f);

@@ -24,12 +24,14 @@ struct SurfaceHit {
   Color emitted(const Vec3& w) const { return glm::dot(w, ng) > 0.0f ? emission : Color(0.0f); }
 };
 
-// Origin for a ray leaving p in direction dir: pushed off the surface along the geometric normal,
-// to the side dir leaves on, by an amount proportional to the magnitude of p's coordinates, where
-// float rounding of the hit point grows (Woo et al. 1996; PBRT4 section 6.8.6 derives exact bounds).
-inline Vec3 offsetRayOrigin(const Vec3& p, const Vec3& ng, const Vec3& dir) {
-  const float scale = 1.0f + maxComponent(glm::abs(p));
-  const float eps = 3e-5f * scale;
+// Origin for a ray leaving a hit point in direction dir: pushed off the surface along the geometric
+// normal, to the side dir leaves on (Woo et al. 1996). The push is a small multiple of the float
+// rounding error of the hit point, which grows with the magnitude of its coordinates and with the
+// ray distance t it was found at (p = o + t d; PBRT4 section 6.8 derives exact bounds): large
+// enough to escape self-intersection, small enough not to cross a neighbouring face near an acute
+// edge (a cone's rim).
+inline Vec3 offsetRayOrigin(const Vec3& p, const Vec3& ng, const Vec3& dir, float t = 0.0f) {
+  const float eps = 2e-6f * (maxComponent(glm::abs(p)) + std::abs(t)) + 1e-7f;
   return p + (glm::dot(dir, ng) >= 0.0f ? eps : -eps) * ng;
 }
 

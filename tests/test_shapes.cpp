@@ -31,6 +31,7 @@
 #include <array>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -383,8 +384,9 @@ TEST(ShapeAll, RaysFromOutsideHitAimedPoint) {
       EXPECT_FALSE(shape->intersect(ray, 0.0f, dist - 1e-3f * dist, other)) << "tMax ignored";
       EXPECT_TRUE(shape->intersect(ray, 0.0f, dist + 1e-3f * dist, other)) << "tMax too strict";
       if (sc.closed && glm::dot(w, s.n) > 0.3f) {
-        // Just past the entry (whose exact root may lie a float ulp above the returned t).
-        const float tMin = hit.t + tol;
+        // Just past the entry, whose exact (double) root may lie up to half a float ulp above the
+        // returned t: four ulps further on.
+        const float tMin = hit.t * (1.0f + 4.0f * std::numeric_limits<float>::epsilon());
         LocalHit exit;
         if (shape->intersect(ray, tMin, kInfinity, exit)) {
           EXPECT_GT(exit.t, tMin);
@@ -879,7 +881,7 @@ void runSpawnTest(const Vec3& offset, uint64_t seed) {
       const Vec3 nFacing = fromFront ? h.ng : -h.ng;
       const Vec3 wr = reflect(-dir, nFacing);
       SurfaceHit h2;
-      if (hitsMe(offsetRayOrigin(h.p, h.ng, wr), wr, h2))
+      if (hitsMe(offsetRayOrigin(h.p, h.ng, wr, h.t), wr, h2))
         st.problem("acne: reflected ray re-hit its shape",
                  "at t = " + std::to_string(h2.t) + ", " + where.str());
       if (!sc.closed) continue;
@@ -889,18 +891,18 @@ void runSpawnTest(const Vec3& offset, uint64_t seed) {
       const bool refracted = refract(-dir, h.ng, 1.5f, wt);
       for (const Vec3& win : {dir, refracted ? wt : dir}) {
         SurfaceHit h3;
-        if (!hitsMe(offsetRayOrigin(h.p, h.ng, win), win, h3) || glm::dot(win, h3.ng) <= 0.0f) {
+        if (!hitsMe(offsetRayOrigin(h.p, h.ng, win, h.t), win, h3) || glm::dot(win, h3.ng) <= 0.0f) {
           st.problem("leak: ray into the shape did not hit its far side",
                    "along " + str(win) + ", " + where.str());
           continue;
         }
         SurfaceHit h4;
-        if (hitsMe(offsetRayOrigin(h3.p, h3.ng, win), win, h4))
+        if (hitsMe(offsetRayOrigin(h3.p, h3.ng, win, h3.t), win, h4))
           st.problem("acne: ray leaving through the far side re-hit its shape",
                      "leaving at " + str(h3.p) + ", t = " + std::to_string(h4.t) + ", " + where.str());
         const Vec3 wIn = reflect(-win, -h3.ng);
         SurfaceHit h5;
-        if (!hitsMe(offsetRayOrigin(h3.p, h3.ng, wIn), wIn, h5) || glm::dot(wIn, h5.ng) <= 0.0f)
+        if (!hitsMe(offsetRayOrigin(h3.p, h3.ng, wIn, h3.t), wIn, h5) || glm::dot(wIn, h5.ng) <= 0.0f)
           st.problem("leak: internal reflection escaped",
                      "reflected at " + str(h3.p) + " ng " + str(h3.ng) + ", " + where.str());
       }
