@@ -1,5 +1,6 @@
 #include "accel/triangle.h"
 
+#include "accel/spherical_rectangle.h"
 #include "renderer/sampling.h"
 
 namespace ember {
@@ -57,8 +58,21 @@ ShapeSample Triangle::sampleArea(Vec2 u) const {
   return {b.x * v_[0] + b.y * v_[1] + (1.0f - b.x - b.y) * v_[2], normal_};
 }
 
+// Parallelogram with a right angle at v0: v2 = v1 + v3 - v0 and (v1 - v0) . (v3 - v0) = 0.
+static bool isRectangleQuad(const std::array<Vec3, 4>& v) {
+  const Vec3 e1 = v[1] - v[0], e2 = v[3] - v[0];
+  const float scale = glm::length(e1) * glm::length(e2);
+  return std::abs(glm::dot(e1, e2)) <= 1e-5f * scale &&
+         glm::length(v[2] - (v[1] + e2)) <= 1e-5f * std::sqrt(scale);
+}
+
+// Below this solid angle the spherical-rectangle inversion loses float precision; area sampling
+// is as good there anyway, since the light is small and far.
+constexpr float kMinSphericalRectangle = 1e-4f;
+
 Quad::Quad(const std::array<Vec3, 4>& v, const std::array<Vec2, 4>& uv)
-    : v_(v),
+    : rectangle_(isRectangleQuad(v)),
+      v_(v),
       uv_(uv),
       normal_(frontNormal(v[0], v[1], v[2])),
       area0_(triangleArea(v[0], v[1], v[2])),
@@ -82,6 +96,27 @@ bool Quad::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) cons
   hit.t = t;
   hit.ng = normal_;
   return true;
+}
+
+bool Quad::sampleSolidAngle(const Vec3& ref, Vec2 u, ShapeSample& s, float& pdf) const {
+  if (rectangle_) {
+    const SphericalRectangle sr(v_[0], v_[1] - v_[0], v_[3] - v_[0], ref);
+    if (sr.solidAngle() > kMinSphericalRectangle) {
+      s.p = sr.sample(u);
+      s.n = normal_;
+      pdf = 1.0f / sr.solidAngle();
+      return true;
+    }
+  }
+  return Shape::sampleSolidAngle(ref, u, s, pdf);
+}
+
+float Quad::pdfSolidAngle(const Vec3& ref, const Vec3& p, const Vec3& n) const {
+  if (rectangle_) {
+    const SphericalRectangle sr(v_[0], v_[1] - v_[0], v_[3] - v_[0], ref);
+    if (sr.solidAngle() > kMinSphericalRectangle) return 1.0f / sr.solidAngle();
+  }
+  return Shape::pdfSolidAngle(ref, p, n);
 }
 
 ShapeSample Quad::sampleArea(Vec2 u) const {

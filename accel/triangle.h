@@ -1,6 +1,8 @@
 // Flat triangle and planar quad (two triangles (v0,v1,v2), (v0,v2,v3), as in ../shared/refs).
 // The front normal is normalize(cross(v1 - v0, v2 - v0)). UVs are per-vertex and interpolated
 // barycentrically; defaults: triangle (0,0), (1,0), (0,1); quad (0,0), (1,0), (1,1), (0,1).
+// A quad that is a rectangle is sampled by solid angle as a light (spherical_rectangle.h); other
+// quads, and rectangles seen at a solid angle too small for that method's float precision, by area.
 #pragma once
 
 #include "accel/shape.h"
@@ -40,8 +42,12 @@ class Quad final : public Shape {
   bool intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const override;
   float area() const override { return area0_ + area1_; }
   ShapeSample sampleArea(Vec2 u) const override;
+  bool sampleSolidAngle(const Vec3& ref, Vec2 u, ShapeSample& s, float& pdf) const override;
+  float pdfSolidAngle(const Vec3& ref, const Vec3& p, const Vec3& n) const override;
+  bool isRectangle() const { return rectangle_; }
 
  private:
+  bool rectangle_;
   std::array<Vec3, 4> v_;
   std::array<Vec2, 4> uv_;
   Vec3 normal_;

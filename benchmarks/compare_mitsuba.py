@@ -1,0 +1,111 @@
+#!/usr/bin/env python3
+"""Side by side with Mitsuba 3 on the shared scenes: relMSE against the 8192-spp references at equal
+samples per pixel, render time, samples/s and efficiency = 1 / (relMSE x seconds), Ember and
+Mitsuba interleaved in the same run. Optional dependency, never needed by the tests:
+
+    python3 -m venv /tmp/mi && /tmp/mi/bin/pip install mitsuba==3.9.1 numpy OpenEXR
+    apt-get install libllvm19      # Mitsuba's llvm_ad_rgb variant needs LLVM >= 16 (Debian 12: 15)
+    DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1 \\
+        /tmp/mi/bin/python benchmarks/compare_mitsuba.py --spp 16 64 256 --seeds 3
+
+Prints a Markdown table (the one quoted in docs/performance.md)."""
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+import OpenEXR
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+sys.path.insert(0, HERE)
+
+
+def load_exr(path):
+    with OpenEXR.File(path) as f:
+        ch = f.channels()
+        if "RGB" in ch:
+            return np.array(ch["RGB"].pixels, dtype=np.float64)
+        return np.stack([np.array(ch[c].pixels, dtype=np.float64) for c in "RGB"], -1)
+
+
+def relmse(img, ref):
+    return float(np.mean((img - ref) ** 2 / (ref ** 2 + 0.01)))
+
+
+def render_ember(ember, scene, spp, seed, threads, out):
+    t = time.perf_counter()
+    subprocess.run([ember, "render", scene, "-o", out, "--spp", str(spp), "--seed", str(seed),
+                    "--threads", str(threads), "-q"], check=True, stderr=subprocess.DEVNULL)
+    return load_exr(out), time.perf_counter() - t
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--scenes", nargs="*", default=["cornell-area", "cornell-point", "shapes", "textured"])
+    ap.add_argument("--spp", nargs="*", type=int, default=[16, 64, 256])
+    ap.add_argument("--seeds", type=int, default=3, help="independent renders per cell; relMSE and time are averaged")
+    ap.add_argument("--variants", nargs="*", default=["llvm_ad_rgb"])
+    ap.add_argument("--threads", type=int, default=os.cpu_count())
+    ap.add_argument("--ember", default=os.path.join(ROOT, "build", "app", "ember"))
+    ap.add_argument("--json", help="also write the raw numbers here")
+    args = ap.parse_args()
+
+    import mitsuba as mi
+    import mitsuba_scene
+
+    tmp = tempfile.mkdtemp(prefix="ember_vs_mitsuba_")
+    rows = []
+    for name in args.scenes:
+        ref = load_exr(os.path.join(ROOT, "tests", "data", name, "reference.exr"))
+        spec = os.path.join(ROOT, "tests", "data", name, "scene.json")
+        for spp in args.spp:
+            row = {"scene": name, "spp": spp}
+            errs, times = [], []
+            for s in range(args.seeds):
+                img, dt = render_ember(args.ember, os.path.join(ROOT, "scenes", name + ".json"), spp, 100 + s, args.threads,
+                                       os.path.join(tmp, "e.exr"))
+                errs.append(relmse(img, ref))
+                times.append(dt)
+            row["ember"] = {"relmse": float(np.mean(errs)), "seconds": float(np.mean(times))}
+            for variant in args.variants:
+                mi.set_variant(variant)
+                mi.set_log_level(mi.LogLevel.Error)
+                errs, times = [], []
+                for s in range(args.seeds):
+                    scene = mitsuba_scene.build(spec, spp, seed=100 + s)
+                    if s == 0:
+                        mi.render(scene, spp=1)  # JIT warm-up, not timed
+                    t = time.perf_counter()
+                    img = np.array(mi.render(scene, spp=spp, seed=100 + s))
+                    times.append(time.perf_counter() - t)
+                    errs.append(relmse(img, ref))
+                row[variant] = {"relmse": float(np.mean(errs)), "seconds": float(np.mean(times))}
+            rows.append(row)
+            print(json.dumps(row), file=sys.stderr, flush=True)
+
+    pixels = 256 * 256
+    variants = args.variants
+    head = "| scene | spp | Ember relMSE | " + " | ".join(f"{v} relMSE" for v in variants) + \
+           " | Ember Msamples/s | " + " | ".join(f"{v} Msamples/s" for v in variants) + \
+           " | efficiency Ember / " + " / ".join(variants) + " |"
+    print(head)
+    print("|" + "---|" * (head.count("|") - 1))
+    for r in rows:
+        e = r["ember"]
+        cells = [r["scene"], str(r["spp"]), f"{e['relmse']:.5f}"] + [f"{r[v]['relmse']:.5f}" for v in variants]
+        cells += [f"{pixels * r['spp'] / e['seconds'] / 1e6:.2f}"] + [f"{pixels * r['spp'] / r[v]['seconds'] / 1e6:.2f}" for v in variants]
+        eff = lambda x: 1.0 / (x["relmse"] * x["seconds"])
+        cells += [" / ".join(f"{eff(e) / eff(r[v]):.2f}" for v in variants)]
+        print("| " + " | ".join(cells) + " |")
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(rows, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()
