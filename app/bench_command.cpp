@@ -78,6 +78,7 @@ int runBench(const BenchArgs& a) {
     RenderOptions options;
     options.spp = scene.settings.spp;
     options.seed = scene.settings.seed;
+    options.sampler = scene.settings.sampler;
     options.threads = a.threads;
     std::vector<RenderStats> runs;
     for (int k = 0; k < a.repeat; ++k) {

@@ -27,6 +27,7 @@ struct RenderArgs {
   std::optional<int> spp, threads, width, height, maxDepth;
   std::optional<uint64_t> seed;
   uint64_t firstSample = 0;
+  std::string sampler;
   bool quiet = false;
 };
 
@@ -59,6 +60,8 @@ int runRender(const RenderArgs& a) {
   if (a.width) s.width = *a.width;
   if (a.height) s.height = *a.height;
   if (a.maxDepth) s.maxDepth = *a.maxDepth;
+  if (a.sampler == "sobol") s.sampler = SamplerType::Sobol;
+  if (a.sampler == "independent") s.sampler = SamplerType::Independent;
   scene.build();
   const double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - loadStart).count();
 
@@ -69,13 +72,15 @@ int runRender(const RenderArgs& a) {
   options.seed = s.seed;
   options.threads = a.threads.value_or(0);
   options.firstSample = a.firstSample;
+  options.sampler = s.sampler;
   options.progress = !a.quiet;
   const RenderStats stats = render(scene, integrator, options, film);
 
   const Image image = film.mean();
   const Metadata meta{
       {"ember:scene", a.scene},           {"ember:spp", std::to_string(s.spp)},
-      {"ember:seed", std::to_string(s.seed)}, {"ember:first_sample", std::to_string(a.firstSample)},
+      {"ember:seed", std::to_string(s.seed)},
+      {"ember:sampler", s.sampler == SamplerType::Sobol ? "sobol" : "independent"}, {"ember:first_sample", std::to_string(a.firstSample)},
       {"ember:render_seconds", std::to_string(stats.seconds)},
       {"ember:version", EMBER_VERSION},   {"DateTime", isoTime()},
       {"Software", std::string("ember ") + EMBER_VERSION}};
@@ -114,6 +119,8 @@ Runner addRenderCommand(CLI::App& app) {
   cmd->add_option("--max-depth", args->maxDepth, "Longest path in segments; -1 = unbounded with Russian roulette")->check(CLI::Range(-1, 100000));
   cmd->add_option("--first-sample", args->firstSample,
                   "Index of the first sample to render: renders [first, first + spp), so separate runs can be merged");
+  cmd->add_option("--sampler", args->sampler, "Random numbers: independent or sobol (Owen-scrambled); default: the scene's")
+      ->check(CLI::IsMember({"independent", "sobol"}));
   cmd->add_option("--variance", args->variance, "Also write the per-pixel variance of the mean as an EXR");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress display (the summary line is still printed)");
   return [args] { return runRender(*args); };

@@ -73,12 +73,18 @@ class JsonSceneLoader {
   }
 
   void readRender(const JsonNode& n) {
-    n.allowKeys({"spp", "max_depth", "rr_depth", "seed", "background"});
+    n.allowKeys({"spp", "max_depth", "rr_depth", "seed", "background", "sampler"});
     RenderSettings& s = scene_.settings;
     if (n.has("spp")) s.spp = n.at("spp").integer(1, 1 << 24);
     if (n.has("max_depth")) s.maxDepth = n.at("max_depth").integer(-1, 100000);
     if (n.has("rr_depth")) s.rrDepth = n.at("rr_depth").integer(1, 100000);
     if (n.has("seed")) s.seed = n.at("seed").unsignedInteger();
+    if (auto sampler = n.find("sampler")) {
+      const std::string v = sampler->string();
+      if (v == "sobol") s.sampler = SamplerType::Sobol;
+      else if (v == "independent") s.sampler = SamplerType::Independent;
+      else sampler->fail("unknown sampler '" + v + "'; valid: independent, sobol");
+    }
     scene_.background = n.color("background", Color(0.0f));
   }
 

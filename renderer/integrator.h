@@ -1,7 +1,7 @@
 // The integrator interface: radiance arriving along a camera ray, estimated with one path.
 #pragma once
 
-#include "renderer/rng.h"
+#include "renderer/sampler.h"
 #include "renderer/scene.h"
 
 #include <cstdint>
@@ -25,7 +25,7 @@ struct PathStats {
 class Integrator {
  public:
   virtual ~Integrator() = default;
-  virtual Color Li(const Scene& scene, Ray ray, Rng& rng, PathStats& stats) const = 0;
+  virtual Color Li(const Scene& scene, Ray ray, Sampler& sampler, PathStats& stats) const = 0;
 };
 
 }  // namespace ember

@@ -5,10 +5,10 @@
 namespace ember {
 
 Color PathIntegrator::sampleLight(const Scene& scene, const SurfaceHit& hit, const Vec3& wo,
-                                  Rng& rng, PathStats& stats) const {
+                                  Sampler& sampler, PathStats& stats) const {
   float pick;
-  const Light* light = scene.lightSampler().sample(rng.uniform(), pick);
-  const Vec2 u(rng.uniform(), rng.uniform());
+  const Light* light = scene.lightSampler().sample(sampler.get1D(), pick);
+  const Vec2 u = sampler.get2D();
   LightSample ls;
   if (!light || !light->sample(hit.p, u, ls) || ls.pdf <= 0.0f || isBlack(ls.Li)) return Color(0.0f);
   const Color f = hit.material->eval(hit, wo, ls.wi);
@@ -28,7 +28,7 @@ Color PathIntegrator::sampleLight(const Scene& scene, const SurfaceHit& hit, con
   return f * ls.Li * (weight / lightPdf);
 }
 
-Color PathIntegrator::Li(const Scene& scene, Ray ray, Rng& rng, PathStats& stats) const {
+Color PathIntegrator::Li(const Scene& scene, Ray ray, Sampler& sampler, PathStats& stats) const {
   Color radiance(0.0f);
   Color throughput(1.0f);
   float etaProduct = 1.0f;
@@ -66,11 +66,11 @@ Color PathIntegrator::Li(const Scene& scene, Ray ray, Rng& rng, PathStats& stats
     if ((maxDepth_ >= 0 && depth >= maxDepth_) || !hit.material) break;
 
     if (hit.material->hasNonDeltaLobes() && !lights.empty())
-      radiance += throughput * sampleLight(scene, hit, wo, rng, stats);
+      radiance += throughput * sampleLight(scene, hit, wo, sampler, stats);
 
     BsdfSample bs;
-    const Vec2 u(rng.uniform(), rng.uniform());
-    if (!hit.material->sample(hit, wo, u, rng.uniform(), bs)) break;
+    const Vec2 u = sampler.get2D();
+    if (!hit.material->sample(hit, wo, u, sampler.get1D(), bs)) break;
     throughput *= bs.weight;
     if (isBlack(throughput)) break;
     previousDelta = bs.delta;
@@ -81,7 +81,7 @@ Color PathIntegrator::Li(const Scene& scene, Ray ray, Rng& rng, PathStats& stats
 
     if (depth >= rrDepth_) {
       const float q = std::min(maxComponent(throughput) * etaProduct * etaProduct, 0.95f);
-      if (rng.uniform() >= q) break;
+      if (sampler.get1D() >= q) break;
       throughput /= q;
     }
   }

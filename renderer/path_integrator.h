@@ -20,10 +20,10 @@ namespace ember {
 class PathIntegrator final : public Integrator {
  public:
   PathIntegrator(int maxDepth, int rrDepth) : maxDepth_(maxDepth), rrDepth_(rrDepth) {}
-  Color Li(const Scene& scene, Ray ray, Rng& rng, PathStats& stats) const override;
+  Color Li(const Scene& scene, Ray ray, Sampler& sampler, PathStats& stats) const override;
 
  private:
-  Color sampleLight(const Scene& scene, const SurfaceHit& hit, const Vec3& wo, Rng& rng,
+  Color sampleLight(const Scene& scene, const SurfaceHit& hit, const Vec3& wo, Sampler& sampler,
                     PathStats& stats) const;
 
   int maxDepth_;

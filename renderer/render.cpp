@@ -50,10 +50,10 @@ RenderStats render(const Scene& scene, const Integrator& integrator, const Rende
               for (int x = x0; x < x1; ++x) {
                 const uint64_t pixel = uint64_t(y) * uint64_t(width) + uint64_t(x);
                 for (int s = 0; s < options.spp; ++s) {
-                  Rng rng = Rng::forSample(options.seed, pixel, options.firstSample + uint64_t(s));
-                  const float jx = rng.uniform(), jy = rng.uniform();
-                  const Ray ray = camera.generateRay(float(x) + jx, float(y) + jy);
-                  const Color L = integrator.Li(scene, ray, rng, local);
+                  Sampler sampler(options.sampler, options.seed, pixel, options.firstSample + uint64_t(s));
+                  const Vec2 jitter = sampler.get2D();
+                  const Ray ray = camera.generateRay(float(x) + jitter.x, float(y) + jitter.y);
+                  const Color L = integrator.Li(scene, ray, sampler, local);
                   if (isFinite(L)) {
                     film.addSample(x, y, L);
                   } else {

@@ -17,6 +17,7 @@ struct RenderOptions {
   int threads = 0;           // 0 = all cores
   uint64_t firstSample = 0;  // render sample indices [firstSample, firstSample + spp)
   int tileSize = 16;
+  SamplerType sampler = SamplerType::Independent;
   bool progress = false;
 };
 

@@ -7,6 +7,7 @@
 #include "renderer/camera.h"
 #include "renderer/light.h"
 #include "renderer/light_sampler.h"
+#include "renderer/sampler.h"
 #include "renderer/surface_hit.h"
 
 #include <memory>
@@ -23,6 +24,7 @@ struct RenderSettings {
   int maxDepth = -1;  // longest path in segments; -1 = unbounded (Russian roulette ends paths)
   int rrDepth = 5;    // Russian roulette starts after this many segments
   uint64_t seed = 0;
+  SamplerType sampler = SamplerType::Independent;
 };
 
 class Scene {

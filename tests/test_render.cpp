@@ -65,8 +65,8 @@ TEST(Render, SampleRangesMergeIntoTheFullRender) {
 // Returns NaN for every third sample, infinity for every fifth, else 1.
 class PoisonedIntegrator final : public Integrator {
  public:
-  Color Li(const Scene&, Ray, Rng& rng, PathStats&) const override {
-    const uint32_t r = rng.nextU32() % 15;
+  Color Li(const Scene&, Ray, Sampler& sampler, PathStats&) const override {
+    const uint32_t r = uint32_t(sampler.get1D() * 15.0f) % 15;
     if (r % 3 == 0) return Color(NAN, 1.0f, 1.0f);
     if (r % 5 == 0) return Color(INFINITY);
     return Color(1.0f);
