@@ -28,7 +28,9 @@
 // point has density pdfSolidAngle(ref, p, n) only if no other sampled surface point lies along the
 // same direction; otherwise the direction density is the sum over all points on that ray. Hence:
 //  - Convex flat shapes (Disc, Triangle, Quad) seen from any point off their plane: each direction
-//    meets the shape at most once, so directions are tested against pdfSolidAngle directly.
+//    meets the shape at most once, so directions are tested against pdfSolidAngle directly. This
+//    covers both strategies of Quad: area sampling (general quads, and rectangles subtending a tiny
+//    solid angle) and uniform spherical-rectangle sampling of rectangles (close, oblique, behind).
 //  - The sphere seen from outside samples the cone it subtends and returns only the visible
 //    point: one point per direction, tested directly as well (three distances, one of them in the
 //    small-angle Taylor branch).
@@ -90,7 +92,7 @@ namespace {
 // Parameters of the test as a whole.
 
 constexpr double kAlpha = 0.01;     // family-wise significance level over every case in the file
-constexpr int kNumCases = 46;       // m for the Sidak correction: must equal allCases().size()
+constexpr int kNumCases = 50;       // m for the Sidak correction: must equal allCases().size()
 constexpr long kSamples = 1000000;  // samples per case
 constexpr double kMinExpected = 5.0;
 // Absolute error allowed on integrals of the pdf over the sphere: the midpoint rule on the
@@ -839,6 +841,20 @@ const std::vector<Chi2Case>& allCases() {
       const Quad quad(v, kQuadUv);
       flatShape(quad, {v.begin(), v.end()}, placed(kQuadOrigin, 1.0f, 0.6f) + 1.2f * kPlacement.n, s);
     });
+
+    // Rectangular quads are sampled uniformly in the solid angle they subtend (spherical
+    // rectangle), down to a minimum solid angle below which they fall back to area sampling.
+    auto rectangle = [](uint64_t s, float x, float y, float h) {
+      const std::array<Vec3, 4> v = {placed(kQuadOrigin, 0.0f, 0.0f), placed(kQuadOrigin, 2.0f, 0.0f),
+                                     placed(kQuadOrigin, 2.0f, 1.2f), placed(kQuadOrigin, 0.0f, 1.2f)};
+      const Quad quad(v, kQuadUv);
+      EXPECT_TRUE(quad.isRectangle());
+      flatShape(quad, {v.begin(), v.end()}, placed(kQuadOrigin, x, y) + h * kPlacement.n, s);
+    };
+    add("Rectangle_veryClose_sphericalRect", [=](uint64_t s) { rectangle(s, 0.7f, 0.5f, 0.1f); });
+    add("Rectangle_front_oblique_sphericalRect", [=](uint64_t s) { rectangle(s, 3.0f, -0.8f, 1.0f); });
+    add("Rectangle_back_sphericalRect", [=](uint64_t s) { rectangle(s, 1.2f, 0.9f, -0.6f); });
+    add("Rectangle_far_areaFallback", [=](uint64_t s) { rectangle(s, 1.0f, 0.6f, 250.0f); });
 
     // Closed (and one open) area-sampled shapes, from inside.
     add("Cylinder_capped_inside", [](uint64_t s) {
