@@ -32,9 +32,10 @@ class Sampler {
 
   float get1D() {
     if (!sobol_ || dimension_ >= kMaxSobolDimensions) return rng_.uniform();
-    const uint32_t seed = hash(pixelSeed_, dimension_++);
-    const uint32_t i = scramble(index_, hash(seed, 0x5bd1e995u));
-    return toFloat(scramble(reverseBits(i), hash(seed, 1)));
+    const uint32_t seed = dimensionSeed();
+    const uint32_t i = shuffledIndex(seed);
+    // van der Corput: reverseBits(i), Owen-scrambled: reverse(LK(reverse(reverse(i)))).
+    return toFloat(reverseBits(laineKarras(i, seed * 0x9e3779b9u)));
   }
 
   Vec2 get2D() {
@@ -42,11 +43,14 @@ class Sampler {
       const float x = rng_.uniform();
       return {x, rng_.uniform()};
     }
-    const uint32_t seed = hash(pixelSeed_, dimension_++);
-    const uint32_t i = scramble(index_, hash(seed, 0x5bd1e995u));
-    return {toFloat(scramble(reverseBits(i), hash(seed, 1))), toFloat(scramble(sobolSecond(i), hash(seed, 2)))};
+    const uint32_t seed = dimensionSeed();
+    const uint32_t i = shuffledIndex(seed);
+    return {toFloat(reverseBits(laineKarras(i, seed * 0x9e3779b9u))),
+            toFloat(reverseBits(laineKarras(sobolSecondReversed(i), seed * 0x85ebca6bu)))};
   }
 
+  // Dimensions (1D or 2D requests) drawn from the Sobol sequence before the PCG32 stream takes
+  // over: the camera jitter and the first bounces, where stratification pays (docs/performance.md).
   static constexpr uint32_t kMaxSobolDimensions = 64;
 
  private:
@@ -57,12 +61,17 @@ class Sampler {
     x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
     return (x >> 16) | (x << 16);
   }
-  // Second Sobol dimension: direction numbers v_0 = 2^31, v_k = v_{k-1} ^ (v_{k-1} >> 1).
-  static uint32_t sobolSecond(uint32_t i) {
-    uint32_t r = 0;
-    for (uint32_t v = 1u << 31; i; i >>= 1, v ^= v >> 1)
-      if (i & 1u) r ^= v;
-    return r;
+  // Second Sobol dimension, bit-reversed. Its reversed direction numbers are w_k = (1 + x)^k over
+  // GF(2), so bit j of w_k is set iff j is a bit-subset of k (Lucas' theorem), and the point is the
+  // superset-parity ("zeta") transform of the index's bits: five shift-mask-xor steps instead of a
+  // loop over 32 bits (the shuffled index has all 32 bits in use).
+  static uint32_t sobolSecondReversed(uint32_t i) {
+    i ^= (i >> 1) & 0x55555555u;
+    i ^= (i >> 2) & 0x33333333u;
+    i ^= (i >> 4) & 0x0f0f0f0fu;
+    i ^= (i >> 8) & 0x00ff00ffu;
+    i ^= (i >> 16) & 0x0000ffffu;
+    return i;
   }
   // Burley 2020, listing 2: each output bit depends only on less significant input bits.
   static uint32_t laineKarras(uint32_t x, uint32_t seed) {
@@ -76,7 +85,9 @@ class Sampler {
   // Nested uniform (Owen) scrambling of a 32-bit fraction: the hash runs on the bit-reversed value
   // so that each digit is permuted depending on the more significant digits only.
   static uint32_t scramble(uint32_t x, uint32_t seed) { return reverseBits(laineKarras(reverseBits(x), seed)); }
-  static uint32_t hash(uint32_t a, uint32_t b) { return uint32_t(mix64((uint64_t(a) << 32) | b)); }
+  uint32_t dimensionSeed() { return uint32_t(mix64((uint64_t(pixelSeed_) << 32) | dimension_++)); }
+  // Owen-scrambled sample index: a per-dimension shuffle of the pixel's sample order.
+  uint32_t shuffledIndex(uint32_t seed) const { return scramble(index_, seed * 0xc2b2ae35u); }
   static float toFloat(uint32_t x) { return float(x >> 8) * 0x1p-24f; }
 
   Rng rng_;

@@ -30,7 +30,7 @@ std::vector<Vec2> points2D(uint64_t seed, uint64_t pixel, int pair, uint32_t fir
 
 TEST(Sampler, SobolPairsAreZeroMTwoNets) {
   for (uint64_t pixel : {0ull, 17ull, 123456ull})
-    for (int pair : {0, 1, 5, 20}) {
+    for (int pair : {0, 1, 3, 5}) {
       const std::vector<Vec2> pts = points2D(42, pixel, pair);
       for (int a = 0; a <= kLog2N; ++a) {
         const int nx = 1 << a, ny = 1 << (kLog2N - a);
@@ -75,7 +75,7 @@ TEST(Sampler, DifferentPixelsAndDimensionsAreDecorrelated) {
   int n = 0;
   for (uint32_t i = 0; i < 64; ++i) {
     Sampler s(SamplerType::Sobol, 11, 1234, i);
-    for (uint32_t d = 0; d < Sampler::kMaxSobolDimensions + 10; ++d, ++n) {
+    for (uint32_t d = 0; d < Sampler::kMaxSobolDimensions + 10; ++d, ++n) {  // past the Sobol ones too
       const float v = s.get1D();
       sum += v;
       sumSq += double(v) * v;
