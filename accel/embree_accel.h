@@ -38,6 +38,7 @@ class EmbreeAccel {
 
   Bounds bounds() const;
   const char* isaName() const;
+  RTCScene rtcScene() const { return scene_; }  // for the raw-throughput benchmark
 
  private:
   RTCDevice device_ = nullptr;

@@ -66,8 +66,15 @@ static bool isRectangleQuad(const std::array<Vec3, 4>& v) {
          glm::length(v[2] - (v[1] + e2)) <= 1e-5f * std::sqrt(scale);
 }
 
-// Below this solid angle the spherical-rectangle inversion loses float precision; area sampling
-// is as good there anyway, since the light is small and far.
+// Solid-angle sampling pays where the light subtends a wide angle: there the 1 / d^2 and cosine
+// factors vary across it and area sampling wastes samples. From farther than twice the light's
+// size area sampling is nearly as good and far cheaper (no inverse trigonometry), so it is used
+// there; the choice depends on the reference point alone, so sample and pdf always agree.
+static bool useSphericalRectangle(const Vec3& ref, const Vec3& center, float area) {
+  const Vec3 d = ref - center;
+  return glm::dot(d, d) < 4.0f * area;
+}
+// Below this solid angle the spherical-rectangle inversion loses float precision.
 constexpr float kMinSphericalRectangle = 1e-4f;
 
 Quad::Quad(const std::array<Vec3, 4>& v, const std::array<Vec2, 4>& uv)
@@ -99,7 +106,7 @@ bool Quad::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) cons
 }
 
 bool Quad::sampleSolidAngle(const Vec3& ref, Vec2 u, ShapeSample& s, float& pdf) const {
-  if (rectangle_) {
+  if (rectangle_ && useSphericalRectangle(ref, 0.5f * (v_[0] + v_[2]), area())) {
     const SphericalRectangle sr(v_[0], v_[1] - v_[0], v_[3] - v_[0], ref);
     if (sr.solidAngle() > kMinSphericalRectangle) {
       s.p = sr.sample(u);
@@ -112,7 +119,7 @@ bool Quad::sampleSolidAngle(const Vec3& ref, Vec2 u, ShapeSample& s, float& pdf)
 }
 
 float Quad::pdfSolidAngle(const Vec3& ref, const Vec3& p, const Vec3& n) const {
-  if (rectangle_) {
+  if (rectangle_ && useSphericalRectangle(ref, 0.5f * (v_[0] + v_[2]), area())) {
     const SphericalRectangle sr(v_[0], v_[1] - v_[0], v_[3] - v_[0], ref);
     if (sr.solidAngle() > kMinSphericalRectangle) return 1.0f / sr.solidAngle();
   }

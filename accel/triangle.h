@@ -1,8 +1,8 @@
 // Flat triangle and planar quad (two triangles (v0,v1,v2), (v0,v2,v3), as in ../shared/refs).
 // The front normal is normalize(cross(v1 - v0, v2 - v0)). UVs are per-vertex and interpolated
 // barycentrically; defaults: triangle (0,0), (1,0), (0,1); quad (0,0), (1,0), (1,1), (0,1).
-// A quad that is a rectangle is sampled by solid angle as a light (spherical_rectangle.h); other
-// quads, and rectangles seen at a solid angle too small for that method's float precision, by area.
+// As a light, a rectangular quad seen from closer than about twice its size is sampled by solid
+// angle (spherical_rectangle.h); other quads, and rectangles seen from farther, by area.
 #pragma once
 
 #include "accel/shape.h"

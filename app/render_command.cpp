@@ -119,7 +119,7 @@ Runner addRenderCommand(CLI::App& app) {
   cmd->add_option("--max-depth", args->maxDepth, "Longest path in segments; -1 = unbounded with Russian roulette")->check(CLI::Range(-1, 100000));
   cmd->add_option("--first-sample", args->firstSample,
                   "Index of the first sample to render: renders [first, first + spp), so separate runs can be merged");
-  cmd->add_option("--sampler", args->sampler, "Random numbers: independent or sobol (Owen-scrambled); default: the scene's")
+  cmd->add_option("--sampler", args->sampler, "Random numbers: sobol (Owen-scrambled, the default) or independent; default: the scene's render.sampler")
       ->check(CLI::IsMember({"independent", "sobol"}));
   cmd->add_option("--variance", args->variance, "Also write the per-pixel variance of the mean as an EXR");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress display (the summary line is still printed)");

@@ -37,10 +37,10 @@ def relmse(img, ref):
     return float(np.mean((img - ref) ** 2 / (ref ** 2 + 0.01)))
 
 
-def render_ember(ember, scene, spp, seed, threads, out):
+def render_ember(ember, scene, spp, seed, threads, out, sampler):
     t = time.perf_counter()
     subprocess.run([ember, "render", scene, "-o", out, "--spp", str(spp), "--seed", str(seed),
-                    "--threads", str(threads), "-q"], check=True, stderr=subprocess.DEVNULL)
+                    "--threads", str(threads), "--sampler", sampler, "-q"], check=True, stderr=subprocess.DEVNULL)
     return load_exr(out), time.perf_counter() - t
 
 
@@ -50,6 +50,7 @@ def main():
     ap.add_argument("--spp", nargs="*", type=int, default=[16, 64, 256])
     ap.add_argument("--seeds", type=int, default=3, help="independent renders per cell; relMSE and time are averaged")
     ap.add_argument("--variants", nargs="*", default=["llvm_ad_rgb"])
+    ap.add_argument("--samplers", nargs="*", default=["independent", "sobol"], help="Ember samplers to run")
     ap.add_argument("--threads", type=int, default=os.cpu_count())
     ap.add_argument("--ember", default=os.path.join(ROOT, "build", "app", "ember"))
     ap.add_argument("--json", help="also write the raw numbers here")
@@ -65,13 +66,14 @@ def main():
         spec = os.path.join(ROOT, "tests", "data", name, "scene.json")
         for spp in args.spp:
             row = {"scene": name, "spp": spp}
-            errs, times = [], []
-            for s in range(args.seeds):
-                img, dt = render_ember(args.ember, os.path.join(ROOT, "scenes", name + ".json"), spp, 100 + s, args.threads,
-                                       os.path.join(tmp, "e.exr"))
-                errs.append(relmse(img, ref))
-                times.append(dt)
-            row["ember"] = {"relmse": float(np.mean(errs)), "seconds": float(np.mean(times))}
+            for sampler in args.samplers:
+                errs, times = [], []
+                for s in range(args.seeds):
+                    img, dt = render_ember(args.ember, os.path.join(ROOT, "scenes", name + ".json"), spp, 100 + s,
+                                           args.threads, os.path.join(tmp, "e.exr"), sampler)
+                    errs.append(relmse(img, ref))
+                    times.append(dt)
+                row["ember-" + sampler] = {"relmse": float(np.mean(errs)), "seconds": float(np.mean(times))}
             for variant in args.variants:
                 mi.set_variant(variant)
                 mi.set_log_level(mi.LogLevel.Error)
@@ -89,18 +91,18 @@ def main():
             print(json.dumps(row), file=sys.stderr, flush=True)
 
     pixels = 256 * 256
-    variants = args.variants
-    head = "| scene | spp | Ember relMSE | " + " | ".join(f"{v} relMSE" for v in variants) + \
-           " | Ember Msamples/s | " + " | ".join(f"{v} Msamples/s" for v in variants) + \
-           " | efficiency Ember / " + " / ".join(variants) + " |"
+    cols = ["ember-" + s for s in args.samplers] + args.variants
+    base = args.variants[0]
+    head = "| scene | spp | " + " | ".join(f"{c} relMSE" for c in cols) + " | " + \
+           " | ".join(f"{c} Msamples/s" for c in cols) + " | " + \
+           " | ".join(f"efficiency {c} / {base}" for c in cols if c != base) + " |"
     print(head)
     print("|" + "---|" * (head.count("|") - 1))
+    eff = lambda x: 1.0 / (x["relmse"] * x["seconds"])
     for r in rows:
-        e = r["ember"]
-        cells = [r["scene"], str(r["spp"]), f"{e['relmse']:.5f}"] + [f"{r[v]['relmse']:.5f}" for v in variants]
-        cells += [f"{pixels * r['spp'] / e['seconds'] / 1e6:.2f}"] + [f"{pixels * r['spp'] / r[v]['seconds'] / 1e6:.2f}" for v in variants]
-        eff = lambda x: 1.0 / (x["relmse"] * x["seconds"])
-        cells += [" / ".join(f"{eff(e) / eff(r[v]):.2f}" for v in variants)]
+        cells = [r["scene"], str(r["spp"])] + [f"{r[c]['relmse']:.5f}" for c in cols]
+        cells += [f"{pixels * r['spp'] / r[c]['seconds'] / 1e6:.2f}" for c in cols]
+        cells += [f"{eff(r[c]) / eff(r[base]):.2f}" for c in cols if c != base]
         print("| " + " | ".join(cells) + " |")
     if args.json:
         with open(args.json, "w") as f:

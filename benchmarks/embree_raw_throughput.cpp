@@ -1,0 +1,163 @@
+// Raw Embree throughput in the cornell-area geometry: the "limit" Ember's path vertices/s are
+// compared with (docs/performance.md). Casts the same ray mix a path tracer does — incoherent
+// closest-hit rays starting on surfaces inside the box, and shadow rays from those points to the
+// area light — as single rays (rtcIntersect1/rtcOccluded1) and as 8- and 16-wide packets, on 1 and
+// on all threads. The scene is Ember's own (analytic user geometry), so the numbers include the
+// cost of our intersection callbacks, exactly as Ember pays it.
+//   embree_raw_throughput [scene.json] [--rays N]
+#include "io/scene_loader.h"
+#include "renderer/sampling.h"
+
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+namespace ember {
+namespace {
+
+struct RayBatch {
+  std::vector<Ray> closest;
+  std::vector<Ray> shadow;
+  std::vector<float> shadowDist;
+};
+
+// Path-tracer-like rays: start at the first hit of a random camera ray, continue in a cosine
+// direction (closest-hit), and aim a shadow ray at a random point of the light.
+RayBatch makeRays(const Scene& scene, size_t n) {
+  RayBatch b;
+  Rng rng(11, 1);
+  const Vec3 lightCenter(0.0f, 1.98f, 0.0f);
+  while (b.closest.size() < n) {
+    const Ray cam = scene.camera().generateRay(rng.uniform() * 256.0f, rng.uniform() * 256.0f);
+    SurfaceHit hit;
+    if (!scene.intersect(cam, hit)) continue;
+    const Vec3 n0 = glm::dot(hit.ng, cam.dir) < 0.0f ? hit.ng : -hit.ng;
+    const Vec3 dir = Frame(n0).toWorld(sampleCosineHemisphere(Vec2(rng.uniform(), rng.uniform())));
+    b.closest.push_back(Ray{offsetRayOrigin(hit.p, hit.ng, dir, hit.t), dir});
+    const Vec3 target = lightCenter + Vec3(rng.uniform() - 0.5f, 0.0f, rng.uniform() - 0.5f) * 0.5f;
+    const Vec3 origin = offsetRayOrigin(hit.p, hit.ng, target - hit.p, hit.t);
+    const float dist = glm::length(target - origin);
+    b.shadow.push_back(Ray{origin, (target - origin) / dist});
+    b.shadowDist.push_back(dist * 0.9999f);
+  }
+  return b;
+}
+
+template <int N, typename Packet>
+void fillPacket(Packet& p, const Ray* rays, const float* tfar) {
+  for (int i = 0; i < N; ++i) {
+    p.org_x[i] = rays[i].origin.x;
+    p.org_y[i] = rays[i].origin.y;
+    p.org_z[i] = rays[i].origin.z;
+    p.dir_x[i] = rays[i].dir.x;
+    p.dir_y[i] = rays[i].dir.y;
+    p.dir_z[i] = rays[i].dir.z;
+    p.tnear[i] = 0.0f;
+    p.tfar[i] = tfar ? tfar[i] : kInfinity;
+    p.time[i] = 0.0f;
+    p.mask[i] = 0xFFFFFFFFu;
+    p.id[i] = unsigned(i);
+    p.flags[i] = 0;
+  }
+}
+
+// Mrays/s of `work(begin, end)` over n rays on `threads` threads.
+template <typename Work>
+double measure(size_t n, int threads, Work work) {
+  tbb::task_arena arena(threads);
+  const auto t0 = std::chrono::steady_clock::now();
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
+      work(r.begin(), r.end());
+    });
+  });
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return double(n) / s * 1e-6;
+}
+
+int run(int argc, char** argv) {
+  std::string path = std::string(EMBER_SOURCE_DIR) + "/scenes/cornell-area.json";
+  size_t n = 2'000'000;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--rays") && i + 1 < argc) n = std::stoul(argv[++i]);
+    else path = argv[i];
+  }
+  n -= n % 16;
+  Scene scene = loadScene(path);
+  scene.build();
+  const RayBatch b = makeRays(scene, n);
+  RTCScene rtc = scene.accel().rtcScene();
+  const int all = tbb::info::default_concurrency();
+
+  std::printf("%-34s %10s %10s\n", "ray kind (Mrays/s)", "1 thread", std::to_string(all).append(" threads").c_str());
+  auto row = [&](const char* name, auto work) {
+    const double one = measure(n, 1, work);
+    const double many = measure(n, all, work);
+    std::printf("%-34s %10.2f %10.2f\n", name, one, many);
+  };
+  row("incoherent closest-hit, single", [&](size_t lo, size_t hi) {
+    for (size_t i = lo; i < hi; ++i) {
+      SurfaceHit h;
+      scene.intersect(b.closest[i], h);
+    }
+  });
+  row("shadow to light, single", [&](size_t lo, size_t hi) {
+    for (size_t i = lo; i < hi; ++i) scene.occluded(b.shadow[i].origin, b.shadow[i].dir, b.shadowDist[i]);
+  });
+  row("incoherent closest-hit, 8-wide", [&](size_t lo, size_t hi) {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    alignas(32) int valid[8];
+    std::fill(valid, valid + 8, -1);
+    for (size_t i = lo; i + 8 <= hi; i += 8) {
+      alignas(32) RTCRayHit8 rh;
+      fillPacket<8>(rh.ray, &b.closest[i], nullptr);
+      std::fill(rh.hit.geomID, rh.hit.geomID + 8, RTC_INVALID_GEOMETRY_ID);
+      rtcIntersect8(valid, rtc, &ctx, &rh);
+    }
+  });
+  row("incoherent closest-hit, 16-wide", [&](size_t lo, size_t hi) {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    alignas(64) int valid[16];
+    std::fill(valid, valid + 16, -1);
+    for (size_t i = lo; i + 16 <= hi; i += 16) {
+      alignas(64) RTCRayHit16 rh;
+      fillPacket<16>(rh.ray, &b.closest[i], nullptr);
+      std::fill(rh.hit.geomID, rh.hit.geomID + 16, RTC_INVALID_GEOMETRY_ID);
+      rtcIntersect16(valid, rtc, &ctx, &rh);
+    }
+  });
+  row("shadow to light, 16-wide", [&](size_t lo, size_t hi) {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    alignas(64) int valid[16];
+    std::fill(valid, valid + 16, -1);
+    for (size_t i = lo; i + 16 <= hi; i += 16) {
+      alignas(64) RTCRay16 r;
+      fillPacket<16>(r, &b.shadow[i], &b.shadowDist[i]);
+      rtcOccluded16(valid, rtc, &ctx, &r);
+    }
+  });
+  // The mix a path tracer casts: one closest-hit and one shadow ray per path vertex.
+  row("vertex mix (1 closest + 1 shadow)", [&](size_t lo, size_t hi) {
+    for (size_t i = lo; i < hi; ++i) {
+      SurfaceHit h;
+      scene.intersect(b.closest[i], h);
+      scene.occluded(b.shadow[i].origin, b.shadow[i].dir, b.shadowDist[i]);
+    }
+  });
+  std::printf("(vertex mix row: M path vertices/s at the traversal limit)\n");
+  return 0;
+}
+
+}  // namespace
+}  // namespace ember
+
+int main(int argc, char** argv) { return ember::run(argc, argv); }
