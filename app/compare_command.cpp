@@ -22,6 +22,7 @@ namespace {
 struct CompareArgs {
   std::string image, reference, refStderr, variance, heatmap;
   bool json = false;
+  bool ldr = false;
   std::optional<double> maxRelmse;
   std::optional<double> maxFlip;
   double alpha = 0.01;
@@ -68,13 +69,14 @@ int runCompare(const CompareArgs& a) {
   }
 
   const ImageMetrics m = computeMetrics(image, reference);
-  // One tone curve for both images: the reference's (Reinhard 2002, as `ember tonemap`).
+  // One tone curve for both images: the reference's (Reinhard 2002, as `ember tonemap`). With
+  // --ldr the inputs are display-referred already and FLIP sees them as they are.
   float logAverage = 0.0f, white = 0.0f;
-  const Image refDisplay = reinhardLinear(reference, ReinhardParams{}, &logAverage, &white);
+  const Image refDisplay = a.ldr ? reference : reinhardLinear(reference, ReinhardParams{}, &logAverage, &white);
   ReinhardParams shared;
   shared.white = white;
   shared.logAverage = logAverage;
-  const Image imageDisplay = reinhardLinear(image, shared);
+  const Image imageDisplay = a.ldr ? image : reinhardLinear(image, shared);
   const FlipResult flip = computeFlip(refDisplay, imageDisplay, a.ppd);
 
   std::optional<PixelZTest> z;
@@ -167,6 +169,8 @@ Runner addCompareCommand(CLI::App& app) {
   cmd->add_option("--ppd", args->ppd, "FLIP observer resolution in pixels per degree (default 67)")->check(CLI::PositiveNumber);
   cmd->add_option("--heatmap", args->heatmap, "Write the FLIP error map as a PNG (magma colours)");
   cmd->add_flag("--json", args->json, "Print the results as JSON (layout: docs/compare.md)");
+  cmd->add_flag("--ldr", args->ldr,
+                "FLIP: the inputs are display-referred linear values in [0, 1]; skip the tone mapping");
   return [args] {
     try {
       return runCompare(*args);
