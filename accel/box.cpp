@@ -72,8 +72,7 @@ float Box::area() const {
 
 ShapeSample Box::sampleArea(Vec2 u) const {
   // Choose one of the six faces by area, then a uniform point on it.
-  const float faceArea[3] = {4.0f * half_.y * half_.z, 4.0f * half_.z * half_.x,
-                             4.0f * half_.x * half_.y};
+  const float faceArea[3] = {4.0f * half_.y * half_.z, 4.0f * half_.z * half_.x, 4.0f * half_.x * half_.y};
   float pick = u.x * 2.0f * (faceArea[0] + faceArea[1] + faceArea[2]);
   int face = 0;
   while (face < 5 && pick >= faceArea[face / 2]) {

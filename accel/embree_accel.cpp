@@ -58,8 +58,7 @@ void EmbreeAccel::commit() {
   rtcCommitScene(scene_);
   const RTCError err = rtcGetDeviceError(device_);
   if (err != RTC_ERROR_NONE)
-    throw std::runtime_error("Embree failed to build the scene (error " + std::to_string(int(err)) +
-                             ")");
+    throw std::runtime_error("Embree failed to build the scene (error " + std::to_string(int(err)) + ")");
 }
 
 static RTCRay toRtc(const Ray& ray, float tMin) {

@@ -5,8 +5,8 @@
 
 namespace ember {
 
-bool intersectTriangle(const Ray& ray, const Vec3& v0, const Vec3& v1, const Vec3& v2, float tMin,
-                       float tMax, float& t, float& b1, float& b2) {
+bool intersectTriangle(const Ray& ray, const Vec3& v0, const Vec3& v1, const Vec3& v2, float tMin, float tMax,
+                       float& t, float& b1, float& b2) {
   const glm::dvec3 e1 = glm::dvec3(v1) - glm::dvec3(v0);
   const glm::dvec3 e2 = glm::dvec3(v2) - glm::dvec3(v0);
   const glm::dvec3 d(ray.dir);

@@ -13,8 +13,8 @@ namespace ember {
 
 // Moller & Trumbore 1997, "Fast, Minimum Storage Ray/Triangle Intersection", in double precision.
 // On a hit, writes t and the barycentrics (b1, b2) of v1 and v2.
-bool intersectTriangle(const Ray& ray, const Vec3& v0, const Vec3& v1, const Vec3& v2, float tMin,
-                       float tMax, float& t, float& b1, float& b2);
+bool intersectTriangle(const Ray& ray, const Vec3& v0, const Vec3& v1, const Vec3& v2, float tMin, float tMax,
+                       float& t, float& b1, float& b2);
 
 class Triangle final : public Shape {
  public:

@@ -7,9 +7,9 @@
 #include "renderer/path_integrator.h"
 #include "renderer/render.h"
 
-#include <nlohmann/json.hpp>
 #include <sys/resource.h>
 #include <tbb/info.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -25,7 +25,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+double secondsSince(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
 
 std::string cpuModel() {
   std::ifstream in("/proc/cpuinfo");
@@ -74,7 +76,8 @@ int runBench(const BenchArgs& a) {
 
   nlohmann::json report;
   report["ember_version"] = EMBER_VERSION;
-  report["build"] = {{"type", EMBER_BUILD_TYPE}, {"cxx_flags", EMBER_CXX_FLAGS}, {"compiler", EMBER_COMPILER}};
+  report["build"] = {
+      {"type", EMBER_BUILD_TYPE}, {"cxx_flags", EMBER_CXX_FLAGS}, {"compiler", EMBER_COMPILER}};
   report["machine"] = {{"cpu", cpuModel()}, {"cores", tbb::info::default_concurrency()}};
   report["threads"] = a.threads > 0 ? a.threads : tbb::info::default_concurrency();
   report["repeat"] = a.repeat;
@@ -106,7 +109,8 @@ int runBench(const BenchArgs& a) {
       runs.push_back(render(scene, integrator, options, film));
       anonymousMb = std::max(anonymousMb, anonymousResidentMb());  // scene, BVH and film alive
     }
-    std::sort(runs.begin(), runs.end(), [](const RenderStats& x, const RenderStats& y) { return x.seconds < y.seconds; });
+    std::sort(runs.begin(), runs.end(),
+              [](const RenderStats& x, const RenderStats& y) { return x.seconds < y.seconds; });
     const RenderStats& med = runs[runs.size() / 2];
     const double s = std::max(med.seconds, 1e-9);
     nlohmann::json row = {
@@ -130,11 +134,12 @@ int runBench(const BenchArgs& a) {
     };
     for (const RenderStats& r : runs) row["render_seconds_all"].push_back(r.seconds);
     report["scenes"].push_back(row);
-    std::printf("%-22s %7d %5d %8.3f %8.3f %9.3f %10.3f %10.3f %10.3f %10.3f %9llu %8.1f %8.1f\n",
-                std::filesystem::path(path).stem().string().c_str(), options.spp, med.threads, loadSeconds,
-                buildSeconds, med.seconds, double(med.samples) / s * 1e-6, double(med.paths.vertices) / s * 1e-6,
-                double(med.paths.rays + med.paths.shadowRays) / s * 1e-6, double(med.paths.shadowRays) / s * 1e-6,
-                static_cast<unsigned long long>(med.nonFinite), peakResidentMb(), anonymousMb);
+    std::printf(
+        "%-22s %7d %5d %8.3f %8.3f %9.3f %10.3f %10.3f %10.3f %10.3f %9llu %8.1f %8.1f\n",
+        std::filesystem::path(path).stem().string().c_str(), options.spp, med.threads, loadSeconds,
+        buildSeconds, med.seconds, double(med.samples) / s * 1e-6, double(med.paths.vertices) / s * 1e-6,
+        double(med.paths.rays + med.paths.shadowRays) / s * 1e-6, double(med.paths.shadowRays) / s * 1e-6,
+        static_cast<unsigned long long>(med.nonFinite), peakResidentMb(), anonymousMb);
     std::fflush(stdout);
   }
   std::printf("machine: %s, %d cores, Embree ISA %s; ember %s (%s)\n", cpuModel().c_str(),
@@ -158,11 +163,15 @@ int runBench(const BenchArgs& a) {
 
 Runner addBenchCommand(CLI::App& app) {
   auto args = std::make_shared<BenchArgs>();
-  CLI::App* cmd = app.add_subcommand("bench", "Measure load, build and render throughput (samples/s, rays/s) on scenes");
+  CLI::App* cmd =
+      app.add_subcommand("bench", "Measure load, build and render throughput (samples/s, rays/s) on scenes");
   cmd->add_option("scenes", args->scenes, "Scene files (default: the four shared scenes in scenes/)");
-  cmd->add_option("--spp", args->spp, "Samples per pixel (default: each scene's own)")->check(CLI::Range(1, 1 << 24));
-  cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 4096));
-  cmd->add_option("--repeat", args->repeat, "Renders per scene; the median is reported (default 3)")->check(CLI::Range(1, 1000));
+  cmd->add_option("--spp", args->spp, "Samples per pixel (default: each scene's own)")
+      ->check(CLI::Range(1, 1 << 24));
+  cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")
+      ->check(CLI::Range(1, 4096));
+  cmd->add_option("--repeat", args->repeat, "Renders per scene; the median is reported (default 3)")
+      ->check(CLI::Range(1, 1000));
   cmd->add_option("--json", args->json, "Also write the results as JSON (layout: docs/performance.md)");
   return [args] { return runBench(*args); };
 }

@@ -72,7 +72,8 @@ int runCompare(const CompareArgs& a) {
   // One tone curve for both images: the reference's (Reinhard 2002, as `ember tonemap`). With
   // --ldr the inputs are display-referred already and FLIP sees them as they are.
   float logAverage = 0.0f, white = 0.0f;
-  const Image refDisplay = a.ldr ? reference : reinhardLinear(reference, ReinhardParams{}, &logAverage, &white);
+  const Image refDisplay =
+      a.ldr ? reference : reinhardLinear(reference, ReinhardParams{}, &logAverage, &white);
   ReinhardParams shared;
   shared.white = white;
   shared.logAverage = logAverage;
@@ -114,17 +115,20 @@ int runCompare(const CompareArgs& a) {
         {"flip_mean", flip.mean},
         {"nonfinite_pixels", m.nonFinite},
         {"ztest", nullptr},
-        {"criteria", {{"max_relmse", a.maxRelmse ? nlohmann::json(*a.maxRelmse) : nlohmann::json(nullptr)},
-                      {"max_flip", a.maxFlip ? nlohmann::json(*a.maxFlip) : nlohmann::json(nullptr)},
-                      {"ztest", z.has_value()}}},
+        {"criteria",
+         {{"max_relmse", a.maxRelmse ? nlohmann::json(*a.maxRelmse) : nlohmann::json(nullptr)},
+          {"max_flip", a.maxFlip ? nlohmann::json(*a.maxFlip) : nlohmann::json(nullptr)},
+          {"ztest", z.has_value()}}},
         {"passed", passed},
     };
     if (z)
-      j["ztest"] = {{"alpha", z->alpha}, {"variance_pool", a.pool}, {"threshold", z->threshold}, {"tests", z->tests},
-                    {"rejected", z->rejected}, {"max_abs_z", z->maxAbsZ}, {"passed", z->passed()}};
+      j["ztest"] = {{"alpha", z->alpha},    {"variance_pool", a.pool}, {"threshold", z->threshold},
+                    {"tests", z->tests},    {"rejected", z->rejected}, {"max_abs_z", z->maxAbsZ},
+                    {"passed", z->passed()}};
     std::printf("%s\n", j.dump(2).c_str());
   } else {
-    std::printf("image      %s (%dx%d)\nreference  %s\n", a.image.c_str(), image.width, image.height, a.reference.c_str());
+    std::printf("image      %s (%dx%d)\nreference  %s\n", a.image.c_str(), image.width, image.height,
+                a.reference.c_str());
     std::printf("%-10s %12s %12s %12s\n", "", "R", "G", "B");
     auto row = [](const char* name, const std::array<double, 3>& v) {
       std::printf("%-10s %12.6g %12.6g %12.6g\n", name, v[0], v[1], v[2]);
@@ -137,8 +141,9 @@ int runCompare(const CompareArgs& a) {
     std::printf("relMSE (all channels) %.6g, FLIP mean %.6g\n", m.relmseAll, flip.mean);
     if (m.nonFinite) std::printf("non-finite pixels skipped: %zu\n", m.nonFinite);
     if (z)
-      std::printf("z-test: %zu of %zu pixel-channels beyond |z| > %.3f (alpha %.3g, Sidak), max |z| %.3f: %s\n",
-                  z->rejected, z->tests, z->threshold, z->alpha, z->maxAbsZ, z->passed() ? "pass" : "FAIL");
+      std::printf(
+          "z-test: %zu of %zu pixel-channels beyond |z| > %.3f (alpha %.3g, Sidak), max |z| %.3f: %s\n",
+          z->rejected, z->tests, z->threshold, z->alpha, z->maxAbsZ, z->passed() ? "pass" : "FAIL");
     else if (refStderr || variance)
       std::printf("z-test: needs both --variance and --ref-stderr\n");
     std::printf("%s\n", passed ? "PASS" : "FAIL");
@@ -151,8 +156,9 @@ int runCompare(const CompareArgs& a) {
 Runner addCompareCommand(CLI::App& app) {
   auto args = std::make_shared<CompareArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "compare", "Compare an image with a reference: means, MAE, RMSE, relMSE, FLIP, per-pixel z-test.\n"
-                 "Exit code 0 when the chosen criteria pass, 1 when they fail, 2 on bad input.");
+      "compare",
+      "Compare an image with a reference: means, MAE, RMSE, relMSE, FLIP, per-pixel z-test.\n"
+      "Exit code 0 when the chosen criteria pass, 1 when they fail, 2 on bad input.");
   cmd->add_option("image", args->image, "The image under test (linear EXR)")->required();
   cmd->add_option("reference", args->reference, "The reference (linear EXR)")->required();
   cmd->add_option("--ref-stderr", args->refStderr, "Per-pixel standard error of the reference (EXR)");
@@ -162,11 +168,13 @@ Runner addCompareCommand(CLI::App& app) {
   cmd->add_option("--alpha", args->alpha, "Family-wise significance level of the z-test (default 0.01)")
       ->check(CLI::Range(1e-12, 0.5));
   cmd->add_option("--variance-pool", args->pool,
-                  "z-test: use max(own, mean over the (2R+1)^2 neighbourhood) as each pixel's variance (default 2; 0 = per pixel)")
+                  "z-test: use max(own, mean over the (2R+1)^2 neighbourhood) as each pixel's variance "
+                  "(default 2; 0 = per pixel)")
       ->check(CLI::Range(0, 64));
   cmd->add_option("--max-relmse", args->maxRelmse, "Fail when relMSE over all channels exceeds this");
   cmd->add_option("--max-flip", args->maxFlip, "Fail when the FLIP mean exceeds this");
-  cmd->add_option("--ppd", args->ppd, "FLIP observer resolution in pixels per degree (default 67)")->check(CLI::PositiveNumber);
+  cmd->add_option("--ppd", args->ppd, "FLIP observer resolution in pixels per degree (default 67)")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--heatmap", args->heatmap, "Write the FLIP error map as a PNG (magma colours)");
   cmd->add_flag("--json", args->json, "Print the results as JSON (layout: docs/compare.md)");
   cmd->add_flag("--ldr", args->ldr,

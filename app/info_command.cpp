@@ -9,7 +9,8 @@ namespace ember::cli {
 
 Runner addInfoCommand(CLI::App& app) {
   auto path = std::make_shared<std::string>();
-  CLI::App* cmd = app.add_subcommand("info", "Print what a scene file loads: shapes, meshes, lights, materials, bounds");
+  CLI::App* cmd =
+      app.add_subcommand("info", "Print what a scene file loads: shapes, meshes, lights, materials, bounds");
   cmd->add_option("scene", *path, "Scene file: Ember JSON, .gltf or .glb")->required();
   return [path] {
     Scene scene = loadScene(*path);
@@ -35,8 +36,8 @@ Runner addInfoCommand(CLI::App& app) {
     std::printf("shapes:     %zu", scene.shapes.size());
     for (const auto& [type, n] : byType) std::printf("  %s %d", type.c_str(), n);
     std::printf("\nmeshes:     %zu (%zu triangles)\n", scene.meshes.size(), scene.triangleCount());
-    std::printf("lights:     %zu point, %d area, %zu emissive triangles, %s environment\n", pointLights, emitters,
-                emissiveTriangles, scene.environment() ? "1" : "no");
+    std::printf("lights:     %zu point, %d area, %zu emissive triangles, %s environment\n", pointLights,
+                emitters, emissiveTriangles, scene.environment() ? "1" : "no");
     std::printf("materials:  %zu", scene.materials.size());
     for (size_t i = 0; i < scene.materials.size(); ++i)
       std::printf("%s %s (%s)", i ? "," : "", scene.materialNames[i].c_str(),

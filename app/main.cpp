@@ -7,8 +7,9 @@
 #include <map>
 
 int main(int argc, char** argv) {
-  CLI::App app{"Ember: a physically based path tracer on Embree.\n"
-               "Renders analytic JSON scenes and glTF 2.0 files to linear float EXR."};
+  CLI::App app{
+      "Ember: a physically based path tracer on Embree.\n"
+      "Renders analytic JSON scenes and glTF 2.0 files to linear float EXR."};
   app.set_version_flag("--version", std::string("ember ") + EMBER_VERSION);
   app.require_subcommand(1);
   std::map<CLI::App*, ember::cli::Runner> runners;

@@ -37,7 +37,8 @@ void checkOutputPath(const std::string& path, const char* extension, const char*
   for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
   if (ext != extension) throw InputError(path + ": " + what + " must end in " + extension);
   const fs::path dir = fs::path(path).parent_path();
-  if (!dir.empty() && !fs::is_directory(dir)) throw InputError(path + ": output folder " + dir.string() + " does not exist");
+  if (!dir.empty() && !fs::is_directory(dir))
+    throw InputError(path + ": output folder " + dir.string() + " does not exist");
 }
 
 std::string isoTime() {
@@ -63,7 +64,8 @@ int runRender(const RenderArgs& a) {
   if (a.sampler == "sobol") s.sampler = SamplerType::Sobol;
   if (a.sampler == "independent") s.sampler = SamplerType::Independent;
   scene.build();
-  const double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - loadStart).count();
+  const double loadSeconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - loadStart).count();
 
   const PathIntegrator integrator(s.maxDepth, s.rrDepth);
   Film film(s.width, s.height);
@@ -77,13 +79,15 @@ int runRender(const RenderArgs& a) {
   const RenderStats stats = render(scene, integrator, options, film);
 
   const Image image = film.mean();
-  const Metadata meta{
-      {"ember:scene", a.scene},           {"ember:spp", std::to_string(s.spp)},
-      {"ember:seed", std::to_string(s.seed)},
-      {"ember:sampler", s.sampler == SamplerType::Sobol ? "sobol" : "independent"}, {"ember:first_sample", std::to_string(a.firstSample)},
-      {"ember:render_seconds", std::to_string(stats.seconds)},
-      {"ember:version", EMBER_VERSION},   {"DateTime", isoTime()},
-      {"Software", std::string("ember ") + EMBER_VERSION}};
+  const Metadata meta{{"ember:scene", a.scene},
+                      {"ember:spp", std::to_string(s.spp)},
+                      {"ember:seed", std::to_string(s.seed)},
+                      {"ember:sampler", s.sampler == SamplerType::Sobol ? "sobol" : "independent"},
+                      {"ember:first_sample", std::to_string(a.firstSample)},
+                      {"ember:render_seconds", std::to_string(stats.seconds)},
+                      {"ember:version", EMBER_VERSION},
+                      {"DateTime", isoTime()},
+                      {"Software", std::string("ember ") + EMBER_VERSION}};
   writeExr(a.output, image, meta);
   if (!a.variance.empty()) writeExr(a.variance, film.varianceOfMean(), meta);
   if (!a.png.empty()) {
@@ -107,19 +111,31 @@ int runRender(const RenderArgs& a) {
 
 Runner addRenderCommand(CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
-  CLI::App* cmd = app.add_subcommand("render", "Render a scene (Ember JSON, .gltf or .glb) to a linear float EXR");
-  cmd->add_option("scene", args->scene, "Scene file: Ember JSON (docs/scene-format.md), .gltf or .glb")->required();
-  cmd->add_option("-o,--output", args->output, "Output EXR (linear float32 RGB), written atomically")->required();
+  CLI::App* cmd =
+      app.add_subcommand("render", "Render a scene (Ember JSON, .gltf or .glb) to a linear float EXR");
+  cmd->add_option("scene", args->scene, "Scene file: Ember JSON (docs/scene-format.md), .gltf or .glb")
+      ->required();
+  cmd->add_option("-o,--output", args->output, "Output EXR (linear float32 RGB), written atomically")
+      ->required();
   cmd->add_option("--png", args->png, "Also write a tone-mapped (Reinhard 2002) sRGB PNG");
-  cmd->add_option("--spp", args->spp, "Samples per pixel (default: the scene's render.spp, else 64)")->check(CLI::Range(1, 1 << 24));
+  cmd->add_option("--spp", args->spp, "Samples per pixel (default: the scene's render.spp, else 64)")
+      ->check(CLI::Range(1, 1 << 24));
   cmd->add_option("--seed", args->seed, "Random seed (default: the scene's render.seed, else 0)");
-  cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 4096));
-  cmd->add_option("--width", args->width, "Image width in pixels (overrides the scene)")->check(CLI::Range(1, 16384));
-  cmd->add_option("--height", args->height, "Image height in pixels (overrides the scene)")->check(CLI::Range(1, 16384));
-  cmd->add_option("--max-depth", args->maxDepth, "Longest path in segments; -1 = unbounded with Russian roulette")->check(CLI::Range(-1, 100000));
-  cmd->add_option("--first-sample", args->firstSample,
-                  "Index of the first sample to render: renders [first, first + spp), so separate runs can be merged");
-  cmd->add_option("--sampler", args->sampler, "Random numbers: sobol (Owen-scrambled, the default) or independent; default: the scene's render.sampler")
+  cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")
+      ->check(CLI::Range(1, 4096));
+  cmd->add_option("--width", args->width, "Image width in pixels (overrides the scene)")
+      ->check(CLI::Range(1, 16384));
+  cmd->add_option("--height", args->height, "Image height in pixels (overrides the scene)")
+      ->check(CLI::Range(1, 16384));
+  cmd->add_option("--max-depth", args->maxDepth,
+                  "Longest path in segments; -1 = unbounded with Russian roulette")
+      ->check(CLI::Range(-1, 100000));
+  cmd->add_option(
+      "--first-sample", args->firstSample,
+      "Index of the first sample to render: renders [first, first + spp), so separate runs can be merged");
+  cmd->add_option("--sampler", args->sampler,
+                  "Random numbers: sobol (Owen-scrambled, the default) or independent; default: the scene's "
+                  "render.sampler")
       ->check(CLI::IsMember({"independent", "sobol"}));
   cmd->add_option("--variance", args->variance, "Also write the per-pixel variance of the mean as an EXR");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress display (the summary line is still printed)");

@@ -73,9 +73,8 @@ double measure(size_t n, int threads, Work work) {
   tbb::task_arena arena(threads);
   const auto t0 = std::chrono::steady_clock::now();
   arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
-      work(r.begin(), r.end());
-    });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096),
+                      [&](const tbb::blocked_range<size_t>& r) { work(r.begin(), r.end()); });
   });
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return double(n) / s * 1e-6;
@@ -85,8 +84,10 @@ int run(int argc, char** argv) {
   std::string path = std::string(EMBER_SOURCE_DIR) + "/scenes/cornell-area.json";
   size_t n = 2'000'000;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--rays") && i + 1 < argc) n = std::stoul(argv[++i]);
-    else path = argv[i];
+    if (!std::strcmp(argv[i], "--rays") && i + 1 < argc)
+      n = std::stoul(argv[++i]);
+    else
+      path = argv[i];
   }
   n -= n % 16;
   Scene scene = loadScene(path);
@@ -95,7 +96,8 @@ int run(int argc, char** argv) {
   RTCScene rtc = scene.accel().rtcScene();
   const int all = tbb::info::default_concurrency();
 
-  std::printf("%-34s %10s %10s\n", "ray kind (Mrays/s)", "1 thread", std::to_string(all).append(" threads").c_str());
+  std::printf("%-34s %10s %10s\n", "ray kind (Mrays/s)", "1 thread",
+              std::to_string(all).append(" threads").c_str());
   auto row = [&](const char* name, auto work) {
     const double one = measure(n, 1, work);
     const double many = measure(n, all, work);
@@ -160,4 +162,6 @@ int run(int argc, char** argv) {
 }  // namespace
 }  // namespace ember
 
-int main(int argc, char** argv) { return ember::run(argc, argv); }
+int main(int argc, char** argv) {
+  return ember::run(argc, argv);
+}

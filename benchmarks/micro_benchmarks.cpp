@@ -24,15 +24,24 @@ namespace {
 
 std::unique_ptr<Shape> makeShape(int kind) {
   switch (kind) {
-    case 0: return std::make_unique<Sphere>(Vec3(0.0f), 0.5f);
-    case 1: return std::make_unique<Disc>(Vec3(0.0f), Vec3(0.2f, 0.3f, 1.0f), 0.5f);
-    case 2: return std::make_unique<Cylinder>(Vec3(0.0f, -0.4f, 0.0f), Vec3(0.0f, 0.4f, 0.1f), 0.4f, true);
-    case 3: return std::make_unique<Cone>(Vec3(0.0f, -0.4f, 0.0f), Vec3(0.0f, 0.4f, 0.0f), 0.4f, true);
-    case 4: return std::make_unique<Box>(Vec3(0.0f), Vec3(0.7f), glm::mat3(1.0f));
-    case 5: return std::make_unique<Triangle>(std::array<Vec3, 3>{Vec3(-0.5f, -0.5f, 0), Vec3(0.5f, -0.5f, 0), Vec3(0, 0.5f, 0)},
-                                              std::array<Vec2, 3>{Vec2(0, 0), Vec2(1, 0), Vec2(0, 1)});
-    default: return std::make_unique<Quad>(std::array<Vec3, 4>{Vec3(-0.5f, -0.5f, 0), Vec3(0.5f, -0.5f, 0), Vec3(0.5f, 0.5f, 0), Vec3(-0.5f, 0.5f, 0)},
-                                           std::array<Vec2, 4>{Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)});
+    case 0:
+      return std::make_unique<Sphere>(Vec3(0.0f), 0.5f);
+    case 1:
+      return std::make_unique<Disc>(Vec3(0.0f), Vec3(0.2f, 0.3f, 1.0f), 0.5f);
+    case 2:
+      return std::make_unique<Cylinder>(Vec3(0.0f, -0.4f, 0.0f), Vec3(0.0f, 0.4f, 0.1f), 0.4f, true);
+    case 3:
+      return std::make_unique<Cone>(Vec3(0.0f, -0.4f, 0.0f), Vec3(0.0f, 0.4f, 0.0f), 0.4f, true);
+    case 4:
+      return std::make_unique<Box>(Vec3(0.0f), Vec3(0.7f), glm::mat3(1.0f));
+    case 5:
+      return std::make_unique<Triangle>(
+          std::array<Vec3, 3>{Vec3(-0.5f, -0.5f, 0), Vec3(0.5f, -0.5f, 0), Vec3(0, 0.5f, 0)},
+          std::array<Vec2, 3>{Vec2(0, 0), Vec2(1, 0), Vec2(0, 1)});
+    default:
+      return std::make_unique<Quad>(std::array<Vec3, 4>{Vec3(-0.5f, -0.5f, 0), Vec3(0.5f, -0.5f, 0),
+                                                        Vec3(0.5f, 0.5f, 0), Vec3(-0.5f, 0.5f, 0)},
+                                    std::array<Vec2, 4>{Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)});
   }
 }
 const char* kShapeNames[] = {"sphere", "disc", "cylinder", "cone", "box", "triangle", "quad"};
@@ -51,7 +60,8 @@ std::vector<Ray> randomRays(size_t n) {
 
 void shapeQuery(benchmark::State& state, bool occlusion) {
   Scene scene;
-  const Material* m = scene.addMaterial("grey", std::make_unique<Lambertian>(std::make_shared<ConstantTexture>(Color(0.5f))));
+  const Material* m =
+      scene.addMaterial("grey", std::make_unique<Lambertian>(std::make_shared<ConstantTexture>(Color(0.5f))));
   scene.shapes.push_back({"shape", makeShape(int(state.range(0))), m, Color(0.0f)});
   scene.build();
   const std::vector<Ray> rays = randomRays(4096);
@@ -69,18 +79,26 @@ void shapeQuery(benchmark::State& state, bool occlusion) {
   state.SetItemsProcessed(int64_t(state.iterations()));
   state.SetLabel(kShapeNames[state.range(0)]);
 }
-void BM_ShapeIntersect(benchmark::State& state) { shapeQuery(state, false); }
-void BM_ShapeOccluded(benchmark::State& state) { shapeQuery(state, true); }
+void BM_ShapeIntersect(benchmark::State& state) {
+  shapeQuery(state, false);
+}
+void BM_ShapeOccluded(benchmark::State& state) {
+  shapeQuery(state, true);
+}
 BENCHMARK(BM_ShapeIntersect)->DenseRange(0, 6);
 BENCHMARK(BM_ShapeOccluded)->DenseRange(0, 6);
 
 std::unique_ptr<Material> makeMaterial(int kind) {
   auto kd = std::make_shared<ConstantTexture>(Color(0.5f));
   switch (kind) {
-    case 0: return std::make_unique<Lambertian>(kd);
-    case 1: return std::make_unique<Phong>(kd, Color(0.4f), 50.0f);
-    case 2: return std::make_unique<Mirror>(Color(1.0f));
-    case 3: return std::make_unique<Dielectric>(1.5f, 1.0f);
+    case 0:
+      return std::make_unique<Lambertian>(kd);
+    case 1:
+      return std::make_unique<Phong>(kd, Color(0.4f), 50.0f);
+    case 2:
+      return std::make_unique<Mirror>(Color(1.0f));
+    case 3:
+      return std::make_unique<Dielectric>(1.5f, 1.0f);
     default: {
       MixedCoefficients c;
       c.kd = kd;
@@ -158,9 +176,10 @@ void BM_LightSampler(benchmark::State& state) {
   std::vector<Light*> raw;
   for (int i = 0; i < n; ++i) {
     const float x = float(i % 32) * 0.1f, z = float(i / 32) * 0.1f;
-    shapes.push_back(std::make_unique<Quad>(
-        std::array<Vec3, 4>{Vec3(x, 2, z), Vec3(x + 0.05f, 2, z), Vec3(x + 0.05f, 2, z + 0.05f), Vec3(x, 2, z + 0.05f)},
-        std::array<Vec2, 4>{Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)}));
+    shapes.push_back(
+        std::make_unique<Quad>(std::array<Vec3, 4>{Vec3(x, 2, z), Vec3(x + 0.05f, 2, z),
+                                                   Vec3(x + 0.05f, 2, z + 0.05f), Vec3(x, 2, z + 0.05f)},
+                               std::array<Vec2, 4>{Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)}));
     lights.push_back(std::make_unique<AreaLight>(shapes.back().get(), Color(1.0f + float(i % 7))));
     raw.push_back(lights.back().get());
   }

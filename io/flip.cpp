@@ -42,7 +42,9 @@ Vec3 xyzToLab(const Vec3& c) {
 }
 
 // Hunt effect: chroma scales with lightness (paper eq. 2).
-Vec3 hunt(const Vec3& lab) { return {lab.x, 0.01f * lab.x * lab.y, 0.01f * lab.x * lab.z}; }
+Vec3 hunt(const Vec3& lab) {
+  return {lab.x, 0.01f * lab.x * lab.y, 0.01f * lab.x * lab.z};
+}
 
 // HyAB distance (Abasi et al. 2020): city-block in lightness, Euclidean in chroma.
 float hyab(const Vec3& a, const Vec3& b) {
@@ -58,10 +60,12 @@ struct Kernel {
 // Contrast sensitivity functions as sums of Gaussians in the spatial domain (paper eq. 1 and
 // table 1): S(x) = sum_i a_i sqrt(pi / b_i) exp(-pi^2 x^2 / b_i), x in degrees of visual angle.
 std::array<Kernel, 3> csfKernels(float ppd) {
-  struct Params { float a1, b1, a2, b2; };
-  const Params channels[3] = {{1.0f, 0.0047f, 0.0f, 1e-5f},     // achromatic
-                              {1.0f, 0.0053f, 0.0f, 1e-5f},     // red-green
-                              {34.1f, 0.04f, 13.5f, 0.025f}};   // blue-yellow
+  struct Params {
+    float a1, b1, a2, b2;
+  };
+  const Params channels[3] = {{1.0f, 0.0047f, 0.0f, 1e-5f},    // achromatic
+                              {1.0f, 0.0053f, 0.0f, 1e-5f},    // red-green
+                              {34.1f, 0.04f, 13.5f, 0.025f}};  // blue-yellow
   const float maxB = 0.04f;
   const int radius = int(std::ceil(3.0f * std::sqrt(maxB / (2.0f * kPi * kPi)) * ppd));
   std::array<Kernel, 3> kernels;
@@ -148,7 +152,8 @@ FlipResult computeFlip(const Image& reference, const Image& test, float ppd) {
 
   // The largest colour difference FLIP can see: between pure green and pure blue (paper sec. 4.1).
   constexpr float qc = 0.7f, pc = 0.4f, pt = 0.95f, qf = 0.5f;
-  const float cmax = std::pow(hyab(hunt(xyzToLab(rgbToXyz(Vec3(0, 1, 0)))), hunt(xyzToLab(rgbToXyz(Vec3(0, 0, 1))))), qc);
+  const float cmax =
+      std::pow(hyab(hunt(xyzToLab(rgbToXyz(Vec3(0, 1, 0)))), hunt(xyzToLab(rgbToXyz(Vec3(0, 0, 1))))), qc);
 
   FlipResult result;
   result.errorMap.resize(n);
@@ -161,8 +166,9 @@ FlipResult computeFlip(const Image& reference, const Image& test, float ppd) {
         const auto& src = ycc[i];
         Vec3 filtered;
         for (int c = 0; c < 3; ++c)
-          filtered[c] = convolve(csf[size_t(c)], w, h, x, y, false,
-                                 [&](int sx, int sy) { return src[size_t(sy) * size_t(w) + size_t(sx)][c]; }, 0.0f);
+          filtered[c] = convolve(
+              csf[size_t(c)], w, h, x, y, false,
+              [&](int sx, int sy) { return src[size_t(sy) * size_t(w) + size_t(sx)][c]; }, 0.0f);
         const Vec3 rgb = glm::clamp(xyzToRgb(ycxczToXyz(filtered)), Vec3(0.0f), Vec3(1.0f));
         lab[i] = hunt(xyzToLab(rgbToXyz(rgb)));
         const auto& l = lum[i];
@@ -176,8 +182,8 @@ FlipResult computeFlip(const Image& reference, const Image& test, float ppd) {
       }
       // Colour error, compressed so that differences beyond pc * cmax saturate slowly (eq. 4).
       const float dc = std::pow(hyab(lab[0], lab[1]), qc);
-      const float ec = dc < pc * cmax ? (pt / (pc * cmax)) * dc
-                                      : pt + (dc - pc * cmax) / (cmax - pc * cmax) * (1.0f - pt);
+      const float ec =
+          dc < pc * cmax ? (pt / (pc * cmax)) * dc : pt + (dc - pc * cmax) / (cmax - pc * cmax) * (1.0f - pt);
       // Feature error (eq. 5) and the final combination (eq. 6).
       const float df = std::max(std::abs(edgeMag[0] - edgeMag[1]), std::abs(pointMag[0] - pointMag[1]));
       const float ef = std::pow(std::min(1.0f, df / std::sqrt(2.0f)), qf);

@@ -4,9 +4,9 @@
 #include "io/input_error.h"
 #include "materials/lambertian.h"
 
+#include <tiny_gltf.h>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
-#include <tiny_gltf.h>
 
 #include <cstdio>
 #include <cstring>
@@ -72,7 +72,8 @@ class GltfImporter {
     }
     Mat4 m(1.0f);
     if (node.translation.size() == 3)
-      m = glm::translate(m, Vec3(float(node.translation[0]), float(node.translation[1]), float(node.translation[2])));
+      m = glm::translate(
+          m, Vec3(float(node.translation[0]), float(node.translation[1]), float(node.translation[2])));
     if (node.rotation.size() == 4) {
       const glm::quat q(float(node.rotation[3]), float(node.rotation[0]), float(node.rotation[1]),
                         float(node.rotation[2]));  // glTF stores x, y, z, w
@@ -109,8 +110,10 @@ class GltfImporter {
     if (size_t(index) >= model_.cameras.size()) return;
     const tinygltf::Camera& cam = model_.cameras[size_t(index)];
     if (cam.type != "perspective") {
-      std::fprintf(stderr, "ember: %s: camera %d is %s; only perspective cameras are used, framing the scene instead\n",
-                   path_.c_str(), index, cam.type.c_str());
+      std::fprintf(
+          stderr,
+          "ember: %s: camera %d is %s; only perspective cameras are used, framing the scene instead\n",
+          path_.c_str(), index, cam.type.c_str());
       return;
     }
     CameraParams c;
@@ -136,15 +139,20 @@ class GltfImporter {
       for (int c = 0; c < components; ++c) {
         float v;
         switch (acc.componentType) {
-          case TINYGLTF_COMPONENT_TYPE_FLOAT: std::memcpy(&v, src + 4 * c, 4); break;
-          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: v = src[c] / 255.0f; break;
+          case TINYGLTF_COMPONENT_TYPE_FLOAT:
+            std::memcpy(&v, src + 4 * c, 4);
+            break;
+          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+            v = src[c] / 255.0f;
+            break;
           case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
             uint16_t s;
             std::memcpy(&s, src + 2 * c, 2);
             v = s / 65535.0f;
             break;
           }
-          default: fail(where, "unsupported component type " + std::to_string(acc.componentType));
+          default:
+            fail(where, "unsupported component type " + std::to_string(acc.componentType));
         }
         if (!std::isfinite(v)) fail(where, "contains NaN or infinite values");
         out[i * size_t(components) + size_t(c)] = v;
@@ -159,15 +167,20 @@ class GltfImporter {
     std::vector<uint32_t> out(acc.count);
     forEachElement(acc, where, [&](const uint8_t* src, size_t i) {
       switch (acc.componentType) {
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: out[i] = src[0]; break;
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+          out[i] = src[0];
+          break;
         case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
           uint16_t s;
           std::memcpy(&s, src, 2);
           out[i] = s;
           break;
         }
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: std::memcpy(&out[i], src, 4); break;
-        default: fail(where, "index component type must be an unsigned integer");
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+          std::memcpy(&out[i], src, 4);
+          break;
+        default:
+          fail(where, "index component type must be an unsigned integer");
       }
     });
     return out;
@@ -185,7 +198,8 @@ class GltfImporter {
     if (acc.bufferView < 0) return;  // spec: no buffer view means all zeros
     if (size_t(acc.bufferView) >= model_.bufferViews.size()) fail(where, "bufferView index out of range");
     const tinygltf::BufferView& view = model_.bufferViews[size_t(acc.bufferView)];
-    if (view.buffer < 0 || size_t(view.buffer) >= model_.buffers.size()) fail(where, "buffer index out of range");
+    if (view.buffer < 0 || size_t(view.buffer) >= model_.buffers.size())
+      fail(where, "buffer index out of range");
     const tinygltf::Buffer& buffer = model_.buffers[size_t(view.buffer)];
     const int componentSize = tinygltf::GetComponentSizeInBytes(uint32_t(acc.componentType));
     const int components = tinygltf::GetNumComponentsInType(uint32_t(acc.type));
@@ -214,18 +228,21 @@ class GltfImporter {
     const auto pos = prim.attributes.find("POSITION");
     if (pos == prim.attributes.end()) fail(where, "primitive has no POSITION attribute");
     size_t vertexCount = 0;
-    const std::vector<float> positions = readFloats(pos->second, TINYGLTF_TYPE_VEC3, where + ".attributes.POSITION", vertexCount);
+    const std::vector<float> positions =
+        readFloats(pos->second, TINYGLTF_TYPE_VEC3, where + ".attributes.POSITION", vertexCount);
 
     auto mesh = std::make_unique<TriangleMesh>();
     mesh->name = where;
     const glm::mat3 normalMatrix = glm::transpose(glm::inverse(glm::mat3(world)));
     mesh->positions.resize(vertexCount);
     for (size_t i = 0; i < vertexCount; ++i)
-      mesh->positions[i] = Vec3(world * glm::vec4(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2], 1.0f));
+      mesh->positions[i] =
+          Vec3(world * glm::vec4(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2], 1.0f));
 
     if (const auto nrm = prim.attributes.find("NORMAL"); nrm != prim.attributes.end()) {
       size_t n = 0;
-      const std::vector<float> normals = readFloats(nrm->second, TINYGLTF_TYPE_VEC3, where + ".attributes.NORMAL", n);
+      const std::vector<float> normals =
+          readFloats(nrm->second, TINYGLTF_TYPE_VEC3, where + ".attributes.NORMAL", n);
       if (n != vertexCount) fail(where + ".attributes.NORMAL", "count differs from POSITION");
       mesh->normals.resize(n);
       for (size_t i = 0; i < n; ++i) {
@@ -236,7 +253,8 @@ class GltfImporter {
     }
     if (const auto uv = prim.attributes.find("TEXCOORD_0"); uv != prim.attributes.end()) {
       size_t n = 0;
-      const std::vector<float> uvs = readFloats(uv->second, TINYGLTF_TYPE_VEC2, where + ".attributes.TEXCOORD_0", n);
+      const std::vector<float> uvs =
+          readFloats(uv->second, TINYGLTF_TYPE_VEC2, where + ".attributes.TEXCOORD_0", n);
       if (n != vertexCount) fail(where + ".attributes.TEXCOORD_0", "count differs from POSITION");
       mesh->uvs.resize(n);
       for (size_t i = 0; i < n; ++i) mesh->uvs[i] = Vec2(uvs[2 * i], uvs[2 * i + 1]);
@@ -247,7 +265,8 @@ class GltfImporter {
       order = readIndices(prim.indices, where + ".indices");
       for (uint32_t idx : order)
         if (idx >= vertexCount)
-          fail(where + ".indices", "index " + std::to_string(idx) + " out of range (" + std::to_string(vertexCount) + " vertices)");
+          fail(where + ".indices", "index " + std::to_string(idx) + " out of range (" +
+                                       std::to_string(vertexCount) + " vertices)");
     } else {
       order.resize(vertexCount);
       for (size_t i = 0; i < vertexCount; ++i) order[i] = uint32_t(i);
@@ -280,7 +299,8 @@ class GltfImporter {
   const Material* materialFor(int index, Color& emission) {
     if (index < 0 || size_t(index) >= model_.materials.size()) {
       if (!defaultMaterial_)
-        defaultMaterial_ = scene_.addMaterial("(glTF default)", std::make_unique<Lambertian>(std::make_shared<ConstantTexture>(Color(0.8f))));
+        defaultMaterial_ = scene_.addMaterial(
+            "(glTF default)", std::make_unique<Lambertian>(std::make_shared<ConstantTexture>(Color(0.8f))));
       return defaultMaterial_;
     }
     const tinygltf::Material& m = model_.materials[size_t(index)];
@@ -292,8 +312,9 @@ class GltfImporter {
     const auto& pbr = m.pbrMetallicRoughness;
     Color factor(1.0f);
     if (pbr.baseColorFactor.size() >= 3)
-      factor = glm::clamp(Color(float(pbr.baseColorFactor[0]), float(pbr.baseColorFactor[1]), float(pbr.baseColorFactor[2])),
-                          Color(0.0f), Color(1.0f));
+      factor = glm::clamp(
+          Color(float(pbr.baseColorFactor[0]), float(pbr.baseColorFactor[1]), float(pbr.baseColorFactor[2])),
+          Color(0.0f), Color(1.0f));
     std::shared_ptr<const Texture> albedo = baseColorTexture(pbr.baseColorTexture.index, factor, index);
     if (!albedo) albedo = std::make_shared<ConstantTexture>(factor);
     const std::string name = m.name.empty() ? "material" + std::to_string(index) : m.name;
@@ -308,13 +329,16 @@ class GltfImporter {
     if (tex.source < 0 || size_t(tex.source) >= model_.images.size()) fail(where, "image index out of range");
     const tinygltf::Image& img = model_.images[size_t(tex.source)];
     if (img.width <= 0 || img.height <= 0 || img.image.empty() || img.bits != 8) {
-      std::fprintf(stderr, "ember: %s: %s: image could not be used (need 8-bit pixels); using baseColorFactor\n",
+      std::fprintf(stderr,
+                   "ember: %s: %s: image could not be used (need 8-bit pixels); using baseColorFactor\n",
                    path_.c_str(), where.c_str());
       return nullptr;
     }
     const size_t expected = size_t(img.width) * size_t(img.height) * size_t(img.component);
-    if (img.component < 1 || img.image.size() < expected) fail(where, "decoded image is smaller than its size says");
-    TextureImage decoded = textureFromBytes(img.image.data(), img.width, img.height, img.component, /*srgb=*/true);
+    if (img.component < 1 || img.image.size() < expected)
+      fail(where, "decoded image is smaller than its size says");
+    TextureImage decoded =
+        textureFromBytes(img.image.data(), img.width, img.height, img.component, /*srgb=*/true);
     TextureWrap wrap = TextureWrap::Repeat;
     TextureFilter filter = TextureFilter::Bilinear;
     if (tex.sampler >= 0 && size_t(tex.sampler) < model_.samplers.size()) {
@@ -323,7 +347,8 @@ class GltfImporter {
       if (s.wrapS == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT) wrap = TextureWrap::Mirror;
       if (s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST) filter = TextureFilter::Nearest;
     }
-    return std::make_shared<ImageTexture>(decoded.width, decoded.height, std::move(decoded.texels), filter, wrap, factor);
+    return std::make_shared<ImageTexture>(decoded.width, decoded.height, std::move(decoded.texels), filter,
+                                          wrap, factor);
   }
 
   std::string path_;

@@ -15,7 +15,9 @@ double twoSidedNormalQuantile(double p) {
   return 0.5 * (lo + hi);
 }
 
-double sidakLevel(double alpha, int m) { return -std::expm1(std::log1p(-alpha) / double(m)); }
+double sidakLevel(double alpha, int m) {
+  return -std::expm1(std::log1p(-alpha) / double(m));
+}
 
 Image squared(const Image& stderrImage) {
   Image out = stderrImage;

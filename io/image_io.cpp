@@ -44,9 +44,10 @@ template <typename WriteFn>
 void writeAtomically(const std::string& path, WriteFn write) {
   namespace fs = std::filesystem;
   const fs::path target(path);
-  const fs::path tmp = target.parent_path() /
-                       ("." + target.stem().string() + ".tmp" + std::to_string(getpid()) +
-                        target.extension().string());
+  std::string name = ".";  // appended piecewise: GCC 12's -Wrestrict misfires on "." + string
+  name.append(target.stem().string()).append(".tmp").append(std::to_string(getpid()));
+  name.append(target.extension().string());
+  const fs::path tmp = target.parent_path() / name;
   try {
     write(tmp.string());
     fs::rename(tmp, target);
@@ -61,7 +62,8 @@ void writeWithOiio(const std::string& path, const OIIO::ImageSpec& spec, OIIO::T
                    const void* pixels) {
   auto out = OIIO::ImageOutput::create(path);
   if (!out) throw std::runtime_error(path + ": cannot create image writer: " + OIIO::geterror());
-  if (!out->open(path, spec)) throw std::runtime_error(path + ": cannot open for writing: " + out->geterror());
+  if (!out->open(path, spec))
+    throw std::runtime_error(path + ": cannot open for writing: " + out->geterror());
   if (!out->write_image(type, pixels)) throw std::runtime_error(path + ": write failed: " + out->geterror());
   if (!out->close()) throw std::runtime_error(path + ": close failed: " + out->geterror());
 }
@@ -70,8 +72,8 @@ void writeWithOiio(const std::string& path, const OIIO::ImageSpec& spec, OIIO::T
 
 TextureImage readTexture(const std::string& path, ColorEncoding encoding) {
   const RawPixels raw = readRaw(path);
-  const bool integer = raw.format.basetype == OIIO::TypeDesc::UINT8 ||
-                       raw.format.basetype == OIIO::TypeDesc::UINT16;
+  const bool integer =
+      raw.format.basetype == OIIO::TypeDesc::UINT8 || raw.format.basetype == OIIO::TypeDesc::UINT16;
   const bool srgb = encoding == ColorEncoding::Srgb || (encoding == ColorEncoding::Auto && integer);
   TextureImage tex{raw.width, raw.height, {}};
   tex.texels.resize(size_t(raw.width) * size_t(raw.height));

@@ -23,12 +23,18 @@ void JsonNode::fail(std::string_view message) const {
 
 static std::string describe(const nlohmann::json& v) {
   switch (v.type()) {
-    case nlohmann::json::value_t::null: return "null";
-    case nlohmann::json::value_t::object: return "an object";
-    case nlohmann::json::value_t::array: return "an array";
-    case nlohmann::json::value_t::string: return "a string";
-    case nlohmann::json::value_t::boolean: return "a boolean";
-    default: return "a number";
+    case nlohmann::json::value_t::null:
+      return "null";
+    case nlohmann::json::value_t::object:
+      return "an object";
+    case nlohmann::json::value_t::array:
+      return "an array";
+    case nlohmann::json::value_t::string:
+      return "a string";
+    case nlohmann::json::value_t::boolean:
+      return "a boolean";
+    default:
+      return "a number";
   }
 }
 
@@ -95,7 +101,8 @@ float JsonNode::nonNegative() const {
 }
 
 int JsonNode::integer(int min, int max) const {
-  const std::string range = "expected an integer in [" + std::to_string(min) + ", " + std::to_string(max) + "]";
+  const std::string range =
+      "expected an integer in [" + std::to_string(min) + ", " + std::to_string(max) + "]";
   if (!value_->is_number()) fail(range);
   const double v = value_->get<double>();
   if (!std::isfinite(v) || v != std::floor(v) || v < min || v > max) fail(range);

@@ -54,8 +54,8 @@ class JsonNode {
   std::string string() const;
   Vec2 vec2() const;
   Vec3 vec3() const;
-  Vec3 direction() const;     // non-zero, returned normalised
-  Color color() const;        // three numbers >= 0, or one number >= 0 for grey
+  Vec3 direction() const;  // non-zero, returned normalised
+  Color color() const;     // three numbers >= 0, or one number >= 0 for grey
 
   // Shorthands for optional members with defaults.
   float number(std::string_view key, float fallback) const;

@@ -69,7 +69,8 @@ class JsonSceneLoader {
     const Vec3 f = c.target - c.origin;
     if (glm::length(f) == 0.0f) n.at("target").fail("must differ from origin");
     if (glm::length(glm::cross(glm::normalize(f), c.up)) < 1e-6f)
-      (n.has("up") ? n.at("up") : n).fail("up must not be parallel to the view direction (the default up is +y)");
+      (n.has("up") ? n.at("up") : n)
+          .fail("up must not be parallel to the view direction (the default up is +y)");
   }
 
   void readRender(const JsonNode& n) {
@@ -81,9 +82,12 @@ class JsonSceneLoader {
     if (n.has("seed")) s.seed = n.at("seed").unsignedInteger();
     if (auto sampler = n.find("sampler")) {
       const std::string v = sampler->string();
-      if (v == "sobol") s.sampler = SamplerType::Sobol;
-      else if (v == "independent") s.sampler = SamplerType::Independent;
-      else sampler->fail("unknown sampler '" + v + "'; valid: independent, sobol");
+      if (v == "sobol")
+        s.sampler = SamplerType::Sobol;
+      else if (v == "independent")
+        s.sampler = SamplerType::Independent;
+      else
+        sampler->fail("unknown sampler '" + v + "'; valid: independent, sobol");
     }
     scene_.background = n.color("background", Color(0.0f));
   }
@@ -95,22 +99,30 @@ class JsonSceneLoader {
     ColorEncoding encoding = ColorEncoding::Auto;
     if (auto e = n.find("encoding")) {
       const std::string v = e->string();
-      if (v == "srgb") encoding = ColorEncoding::Srgb;
-      else if (v == "linear") encoding = ColorEncoding::Linear;
-      else if (v != "auto") e->fail("unknown encoding '" + v + "'; valid: auto, srgb, linear");
+      if (v == "srgb")
+        encoding = ColorEncoding::Srgb;
+      else if (v == "linear")
+        encoding = ColorEncoding::Linear;
+      else if (v != "auto")
+        e->fail("unknown encoding '" + v + "'; valid: auto, srgb, linear");
     }
     TextureFilter filter = TextureFilter::Bilinear;
     if (auto f = n.find("filter")) {
       const std::string v = f->string();
-      if (v == "nearest") filter = TextureFilter::Nearest;
-      else if (v != "bilinear") f->fail("unknown filter '" + v + "'; valid: nearest, bilinear");
+      if (v == "nearest")
+        filter = TextureFilter::Nearest;
+      else if (v != "bilinear")
+        f->fail("unknown filter '" + v + "'; valid: nearest, bilinear");
     }
     TextureWrap wrap = TextureWrap::Repeat;
     if (auto w = n.find("wrap")) {
       const std::string v = w->string();
-      if (v == "clamp") wrap = TextureWrap::Clamp;
-      else if (v == "mirror") wrap = TextureWrap::Mirror;
-      else if (v != "repeat") w->fail("unknown wrap '" + v + "'; valid: clamp, repeat, mirror");
+      if (v == "clamp")
+        wrap = TextureWrap::Clamp;
+      else if (v == "mirror")
+        wrap = TextureWrap::Mirror;
+      else if (v != "repeat")
+        w->fail("unknown wrap '" + v + "'; valid: clamp, repeat, mirror");
     }
     const fs::path texPath = baseDir_ / file.string();
     TextureImage img;
@@ -146,7 +158,8 @@ class JsonSceneLoader {
       const Color ks = m.color("ks", Color(0.0f));
       const float exponent = m.positive("exponent", 32.0f);
       const Color sum = kd->maxValue() + ks;
-      if (maxComponent(sum) > 1.0f + 1e-6f) m.fail("kd + ks must be <= 1 in every channel (energy conservation)");
+      if (maxComponent(sum) > 1.0f + 1e-6f)
+        m.fail("kd + ks must be <= 1 in every channel (energy conservation)");
       return std::make_unique<Phong>(std::move(kd), ks, exponent);
     }
     if (type == "mirror") {
@@ -172,13 +185,15 @@ class JsonSceneLoader {
       c.exponent = m.positive("exponent", 32.0f);
       c.ior = m.positive("ior", 1.5f);
       const Color kdMax = c.kd->maxValue();
-      const float probabilities = maxComponent(kdMax) + maxComponent(c.ks) + maxComponent(c.kr) + maxComponent(c.kt);
+      const float probabilities =
+          maxComponent(kdMax) + maxComponent(c.ks) + maxComponent(c.kr) + maxComponent(c.kt);
       if (probabilities > 1.0f + 1e-6f)
         m.fail("the largest channels of kd, ks, kr and kt must sum to <= 1 (they are event probabilities)");
       return std::make_unique<Mixed>(std::move(c));
     }
-    m.at("type").fail("unknown material type '" + type +
-                      "'; valid types are: diffuse (alias lambertian), phong, mirror, refraction, dielectric, mixed");
+    m.at("type").fail(
+        "unknown material type '" + type +
+        "'; valid types are: diffuse (alias lambertian), phong, mirror, refraction, dielectric, mixed");
   }
 
   const Material* materialFor(const JsonNode& s, bool emissive) {
@@ -199,7 +214,8 @@ class JsonSceneLoader {
 
   const Material* blackMaterial() {
     if (!black_)
-      black_ = scene_.addMaterial("(black)", std::make_unique<Lambertian>(std::make_shared<ConstantTexture>(Color(0.0f))));
+      black_ = scene_.addMaterial(
+          "(black)", std::make_unique<Lambertian>(std::make_shared<ConstantTexture>(Color(0.0f))));
     return black_;
   }
 
@@ -223,7 +239,8 @@ class JsonSceneLoader {
       shape = std::make_unique<Sphere>(s.at("center").vec3(), s.at("radius").positive());
     } else if (type == "disc" || type == "disk") {
       common({"center", "normal", "radius"});
-      shape = std::make_unique<Disc>(s.at("center").vec3(), s.at("normal").direction(), s.at("radius").positive());
+      shape = std::make_unique<Disc>(s.at("center").vec3(), s.at("normal").direction(),
+                                     s.at("radius").positive());
     } else if (type == "cylinder") {
       common({"p0", "p1", "radius", "caps"});
       const Vec3 p0 = s.at("p0").vec3(), p1 = s.at("p1").vec3();
@@ -249,7 +266,8 @@ class JsonSceneLoader {
       std::array<Vec3, 3> v = readPoints<3>(s.at("vertices"));
       std::array<Vec2, 3> uv{Vec2(0, 0), Vec2(1, 0), Vec2(0, 1)};
       if (auto u = s.find("uvs")) uv = readUvs<3>(*u);
-      if (!(glm::length(glm::cross(v[1] - v[0], v[2] - v[0])) > 0.0f)) s.at("vertices").fail("degenerate triangle (zero area)");
+      if (!(glm::length(glm::cross(v[1] - v[0], v[2] - v[0])) > 0.0f))
+        s.at("vertices").fail("degenerate triangle (zero area)");
       shape = std::make_unique<Triangle>(v, uv);
     } else if (type == "quad") {
       common({"vertices", "uvs"});
@@ -272,7 +290,8 @@ class JsonSceneLoader {
                         "'; valid types are: sphere, disc, cylinder, cone, box, triangle, quad, mesh");
     }
     if (s.boolean("flip_normals", false)) shape = std::make_unique<FlippedShape>(std::move(shape));
-    scene_.shapes.push_back({shapeName(s, type), std::move(shape), materialFor(s, !isBlack(emission)), emission});
+    scene_.shapes.push_back(
+        {shapeName(s, type), std::move(shape), materialFor(s, !isBlack(emission)), emission});
   }
 
   static void checkKeys(const JsonNode& s, const std::vector<std::string_view>& keys) {

@@ -6,7 +6,9 @@
 namespace ember {
 
 // Mirror direction of w about n (both unit, w pointing away from the surface).
-inline Vec3 reflect(const Vec3& w, const Vec3& n) { return 2.0f * glm::dot(w, n) * n - w; }
+inline Vec3 reflect(const Vec3& w, const Vec3& n) {
+  return 2.0f * glm::dot(w, n) * n - w;
+}
 
 // Snell's law (PBRT4 eq. 9.4 ff.): w points away from the surface on n's side, eta = eta_t / eta_i.
 // False on total internal reflection.

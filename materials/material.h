@@ -11,10 +11,10 @@ namespace ember {
 
 struct BsdfSample {
   Vec3 wi;
-  Color weight;       // f(wo, wi) |cos theta_i| / pdf: what the path throughput is multiplied by
-  float pdf = 0.0f;   // solid-angle density of wi; for a delta lobe, the lobe's discrete probability
-  bool delta = false; // wi came from a Dirac lobe (mirror, refraction): no MIS with light sampling
-  float eta = 1.0f;   // relative index of refraction crossed (eta_t / eta_i), 1 for reflection
+  Color weight;        // f(wo, wi) |cos theta_i| / pdf: what the path throughput is multiplied by
+  float pdf = 0.0f;    // solid-angle density of wi; for a delta lobe, the lobe's discrete probability
+  bool delta = false;  // wi came from a Dirac lobe (mirror, refraction): no MIS with light sampling
+  float eta = 1.0f;    // relative index of refraction crossed (eta_t / eta_i), 1 for reflection
 };
 
 class Material {
@@ -27,8 +27,7 @@ class Material {
   // Solid-angle density with which sample() produces wi through its non-delta lobes.
   virtual float pdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const = 0;
   // Samples wi; uLobe picks among lobes, u the direction within one. False: the path is absorbed.
-  virtual bool sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float uLobe,
-                      BsdfSample& out) const = 0;
+  virtual bool sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float uLobe, BsdfSample& out) const = 0;
 
   // Whether eval can be non-zero, i.e. light sampling is worth a shadow ray.
   virtual bool hasNonDeltaLobes() const { return true; }

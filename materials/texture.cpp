@@ -4,7 +4,11 @@ namespace ember {
 
 ImageTexture::ImageTexture(int width, int height, std::vector<Color> texels, TextureFilter filter,
                            TextureWrap wrap, const Color& scale)
-    : width_(width), height_(height), texels_(std::move(texels)), filter_(filter), wrap_(wrap),
+    : width_(width),
+      height_(height),
+      texels_(std::move(texels)),
+      filter_(filter),
+      wrap_(wrap),
       scale_(scale) {
   Color sum(0.0f);
   for (const Color& c : texels_) {

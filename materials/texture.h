@@ -37,8 +37,8 @@ enum class TextureWrap { Clamp, Repeat, Mirror };
 
 class ImageTexture final : public Texture {
  public:
-  ImageTexture(int width, int height, std::vector<Color> texels, TextureFilter filter,
-               TextureWrap wrap, const Color& scale = Color(1.0f));
+  ImageTexture(int width, int height, std::vector<Color> texels, TextureFilter filter, TextureWrap wrap,
+               const Color& scale = Color(1.0f));
   Color eval(Vec2 uv) const override;
   Color maxValue() const override { return max_; }
   Color average() const override { return average_; }

@@ -59,6 +59,8 @@ bool EnvironmentLight::sample(const Vec3&, Vec2 u, LightSample& out) const {
   return true;
 }
 
-float EnvironmentLight::pdf(const Vec3&, const Vec3&, const Vec3&) const { return kUniformSpherePdf; }
+float EnvironmentLight::pdf(const Vec3&, const Vec3&, const Vec3&) const {
+  return kUniformSpherePdf;
+}
 
 }  // namespace ember

@@ -11,11 +11,11 @@
 namespace ember {
 
 struct LightSample {
-  Vec3 wi;               // unit direction from the reference point towards the light
-  Vec3 p;                // the sampled point (unused for infinite lights)
+  Vec3 wi;  // unit direction from the reference point towards the light
+  Vec3 p;   // the sampled point (unused for infinite lights)
   float dist = kInfinity;
-  Color Li{0.0f};        // radiance (or, for delta lights, intensity / d^2) arriving at the ref
-  float pdf = 0.0f;      // solid-angle density of wi; 1 for delta lights
+  Color Li{0.0f};    // radiance (or, for delta lights, intensity / d^2) arriving at the ref
+  float pdf = 0.0f;  // solid-angle density of wi; 1 for delta lights
   bool delta = false;
 };
 

@@ -19,13 +19,19 @@ inline constexpr float kPi = std::numbers::pi_v<float>;
 inline constexpr float kInvPi = 1.0f / kPi;
 inline constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
-inline float maxComponent(const Vec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
-inline bool isBlack(const Color& c) { return c.x == 0.0f && c.y == 0.0f && c.z == 0.0f; }
+inline float maxComponent(const Vec3& v) {
+  return std::max(v.x, std::max(v.y, v.z));
+}
+inline bool isBlack(const Color& c) {
+  return c.x == 0.0f && c.y == 0.0f && c.z == 0.0f;
+}
 inline bool isFinite(const Color& c) {
   return std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z);
 }
 // Rec. 709 luminance of linear RGB.
-inline float luminance(const Color& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+inline float luminance(const Color& c) {
+  return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
+}
 
 struct Ray {
   Vec3 origin;

@@ -4,8 +4,8 @@
 
 namespace ember {
 
-Color PathIntegrator::sampleLight(const Scene& scene, const SurfaceHit& hit, const Vec3& wo,
-                                  Sampler& sampler, PathStats& stats) const {
+Color PathIntegrator::sampleLight(const Scene& scene, const SurfaceHit& hit, const Vec3& wo, Sampler& sampler,
+                                  PathStats& stats) const {
   float pick;
   const Light* light = scene.lightSampler().sample(sampler.get1D(), pick);
   const Vec2 u = sampler.get2D();

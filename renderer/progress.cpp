@@ -23,7 +23,9 @@ ProgressReporter::ProgressReporter(uint64_t totalUnits, uint64_t samplesPerUnit,
   if (enabled_) thread_ = std::thread([this] { run(); });
 }
 
-ProgressReporter::~ProgressReporter() { finish(); }
+ProgressReporter::~ProgressReporter() {
+  finish();
+}
 
 void ProgressReporter::finish() {
   if (!thread_.joinable()) return;
@@ -47,8 +49,7 @@ void ProgressReporter::run() {
 void ProgressReporter::print(bool final) {
   const uint64_t done = std::min(done_.load(std::memory_order_relaxed), total_);
   const double fraction = double(done) / double(total_);
-  const double elapsed =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   const double rate = elapsed > 0.0 ? double(done * samplesPerUnit_) / elapsed : 0.0;
   const double eta = fraction > 0.0 ? elapsed * (1.0 - fraction) / fraction : 0.0;
   if (terminal_) {

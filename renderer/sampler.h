@@ -85,7 +85,9 @@ class Sampler {
   }
   // Nested uniform (Owen) scrambling of a 32-bit fraction: the hash runs on the bit-reversed value
   // so that each digit is permuted depending on the more significant digits only.
-  static uint32_t scramble(uint32_t x, uint32_t seed) { return reverseBits(laineKarras(reverseBits(x), seed)); }
+  static uint32_t scramble(uint32_t x, uint32_t seed) {
+    return reverseBits(laineKarras(reverseBits(x), seed));
+  }
   uint32_t dimensionSeed() { return uint32_t(mix64((uint64_t(pixelSeed_) << 32) | dimension_++)); }
   // Owen-scrambled sample index: a per-dimension shuffle of the pixel's sample order.
   uint32_t shuffledIndex(uint32_t seed) const { return scramble(index_, seed * 0xc2b2ae35u); }

@@ -27,7 +27,9 @@ inline Vec3 sampleCosineHemisphere(Vec2 u) {
   const float z = std::sqrt(std::max(0.0f, 1.0f - d.x * d.x - d.y * d.y));
   return {d.x, d.y, z};
 }
-inline float cosineHemispherePdf(float cosTheta) { return std::max(cosTheta, 0.0f) * kInvPi; }
+inline float cosineHemispherePdf(float cosTheta) {
+  return std::max(cosTheta, 0.0f) * kInvPi;
+}
 
 // Uniform direction on the unit sphere, pdf = 1 / (4 pi).
 inline Vec3 sampleUniformSphere(Vec2 u) {
@@ -46,7 +48,9 @@ inline Vec3 sampleUniformCone(Vec2 u, float cosThetaMax) {
   const float phi = 2.0f * kPi * u.y;
   return {sinTheta * std::cos(phi), sinTheta * std::sin(phi), cosTheta};
 }
-inline float uniformConePdf(float cosThetaMax) { return 1.0f / (2.0f * kPi * (1.0f - cosThetaMax)); }
+inline float uniformConePdf(float cosThetaMax) {
+  return 1.0f / (2.0f * kPi * (1.0f - cosThetaMax));
+}
 
 // Uniform barycentrics on a triangle (PBRT4 eq. A.5.4, the square-root parameterisation).
 inline Vec2 sampleUniformTriangle(Vec2 u) {

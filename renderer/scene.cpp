@@ -82,7 +82,8 @@ bool Scene::intersect(const Ray& ray, SurfaceHit& hit) const {
     hit.ns = glm::dot(s.ns, s.ng) < 0.0f ? -s.ns : s.ns;
   }
   hit.material = rec.material;
-  hit.light = rec.firstTriangleLight >= 0 ? triangleLights_[size_t(rec.firstTriangleLight) + raw.primID] : rec.light;
+  hit.light =
+      rec.firstTriangleLight >= 0 ? triangleLights_[size_t(rec.firstTriangleLight) + raw.primID] : rec.light;
   hit.emission = rec.emission;
   return true;
 }

@@ -18,8 +18,9 @@ struct CliResult {
 };
 
 inline CliResult runEmber(const std::string& args) {
-  const std::string log = (std::filesystem::temp_directory_path() /
-                           ("ember_cli_" + std::to_string(::getpid()) + ".log")).string();
+  const std::string log =
+      (std::filesystem::temp_directory_path() / ("ember_cli_" + std::to_string(::getpid()) + ".log"))
+          .string();
   const std::string cmd = std::string("'") + EMBER_BINARY + "' " + args + " >'" + log + "' 2>&1";
   const int status = std::system(cmd.c_str());
   CliResult r;

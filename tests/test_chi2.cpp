@@ -99,12 +99,14 @@ constexpr double kMinExpected = 5.0;
 // refined sub-grids is far more accurate (errors ~1e-5 on the discontinuous cases here), this only
 // absorbs the float rounding of the pdfs and the O(sin^2) Taylor branch of the sphere's cone.
 constexpr double kIntegralTol = 1e-3;
-constexpr int kCoarseSub = 8;   // k x k midpoint sub-grid per cell
-constexpr int kFineSub = 64;    // sub-grid where the pdf varies by more than kRefineRatio
+constexpr int kCoarseSub = 8;  // k x k midpoint sub-grid per cell
+constexpr int kFineSub = 64;   // sub-grid where the pdf varies by more than kRefineRatio
 constexpr double kRefineRatio = 1.5;
 constexpr double kPiD = std::numbers::pi;
 
-double sidakAlpha() { return 1.0 - std::pow(1.0 - kAlpha, 1.0 / double(kNumCases)); }
+double sidakAlpha() {
+  return 1.0 - std::pow(1.0 - kAlpha, 1.0 / double(kNumCases));
+}
 
 // Two-sided standard normal quantile: z with erfc(z / sqrt 2) = a, by bisection.
 double normalQuantileTwoSided(double a) {
@@ -151,7 +153,9 @@ double gammaQ(double a, double x) {
   return std::clamp(std::exp(logPrefactor) * h, 0.0, 1.0);
 }
 
-double chi2Survival(double chi2, int dof) { return gammaQ(0.5 * dof, 0.5 * chi2); }
+double chi2Survival(double chi2, int dof) {
+  return gammaQ(0.5 * dof, 0.5 * chi2);
+}
 
 // ---------------------------------------------------------------------------------------------
 // Pearson's chi-square with pooling of the sparse cells.
@@ -173,8 +177,7 @@ Chi2Outcome chi2Test(const std::vector<double>& observed, const std::vector<doub
   const size_t n = observed.size();
   std::vector<size_t> order(n);
   std::iota(order.begin(), order.end(), size_t(0));
-  std::stable_sort(order.begin(), order.end(),
-                   [&](size_t a, size_t b) { return expected[a] < expected[b]; });
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return expected[a] < expected[b]; });
 
   Chi2Outcome r;
   double poolObs = 0.0, poolExp = 0.0;
@@ -310,9 +313,10 @@ std::vector<double> integrateGrid(const Basis& b, double z0, double z1, int nz, 
       if (southPole) range(0, 1, 0, nphi - 1, lo, hi);
       if (northPole) range(nz - 2, nz - 1, 0, nphi - 1, lo, hi);
       const size_t cell = size_t(iz * nphi + ip);
-      out[cell] = hi > kRefineRatio * lo
-                      ? midpoint(b, z0 + iz * dz, z0 + (iz + 1) * dz, ip * dphi, (ip + 1) * dphi, kFineSub, pdf).value
-                      : coarse[cell].value;
+      out[cell] =
+          hi > kRefineRatio * lo
+              ? midpoint(b, z0 + iz * dz, z0 + (iz + 1) * dz, ip * dphi, (ip + 1) * dphi, kFineSub, pdf).value
+              : coarse[cell].value;
     }
   });
   return out;
@@ -334,8 +338,8 @@ struct CaseSummary {
 void report(const std::string& what, const Chi2Outcome& r, double integral, double success) {
   std::ostringstream s;
   s.precision(4);
-  s << "[chi2] " << what << ": chi2 " << r.chi2 << ", dof " << r.dof << ", p " << r.pValue
-    << ", pooled " << r.pooledCells << ", integral " << integral << ", success " << success;
+  s << "[chi2] " << what << ": chi2 " << r.chi2 << ", dof " << r.dof << ", p " << r.pValue << ", pooled "
+    << r.pooledCells << ", integral " << integral << ", success " << success;
   std::cout << s.str() << std::endl;
 }
 
@@ -350,8 +354,8 @@ void judge(const Chi2Outcome& r, bool expectReject) {
   if (expectReject) {
     EXPECT_LT(r.pValue, level) << "a wrong pdf was not rejected: chi2 " << r.chi2 << ", dof " << r.dof;
   } else {
-    EXPECT_GE(r.pValue, level) << "samples do not follow the pdf: chi2 " << r.chi2 << ", dof "
-                               << r.dof << ", Sidak level " << level << r.worst;
+    EXPECT_GE(r.pValue, level) << "samples do not follow the pdf: chi2 " << r.chi2 << ", dof " << r.dof
+                               << ", Sidak level " << level << r.worst;
   }
 }
 
@@ -363,9 +367,8 @@ CaseSummary runDirectional(const DirectionalCase& c) {
   const double dz = (1.0 - g.zMin) / g.nz, dphi = 2.0 * kPiD / g.nphi;
 
   // Expected, integrated on other threads while this one samples (pdfs are const and pure).
-  std::future<std::vector<double>> inGridFuture = std::async(std::launch::async, [&] {
-    return integrateGrid(basis, g.zMin, 1.0, g.nz, g.nphi, c.pdf);
-  });
+  std::future<std::vector<double>> inGridFuture =
+      std::async(std::launch::async, [&] { return integrateGrid(basis, g.zMin, 1.0, g.nz, g.nphi, c.pdf); });
   std::future<std::vector<double>> belowFuture = std::async(std::launch::async, [&] {
     return g.zMin > -1.0 ? integrateGrid(basis, -1.0, g.zMin, 20, g.nphi, c.pdf) : std::vector<double>{};
   });
@@ -408,8 +411,8 @@ CaseSummary runDirectional(const DirectionalCase& c) {
     if (int(cell) == outsideCell) return "cells below zMin";
     std::ostringstream s;
     const int iz = int(cell) / g.nphi, ip = int(cell) % g.nphi;
-    s << "cos theta [" << g.zMin + iz * dz << ", " << g.zMin + (iz + 1) * dz << "], phi ["
-      << ip * dphi << ", " << (ip + 1) * dphi << "]";
+    s << "cos theta [" << g.zMin + iz * dz << ", " << g.zMin + (iz + 1) * dz << "], phi [" << ip * dphi
+      << ", " << (ip + 1) * dphi << "]";
     return s.str();
   };
   const Chi2Outcome r = chi2Test(observed, expected, label);
@@ -426,7 +429,9 @@ CaseSummary runDirectional(const DirectionalCase& c) {
 }
 
 // Relative agreement of two densities computed along different float paths.
-bool densitiesAgree(double a, double b) { return std::abs(a - b) <= 1e-3 * std::max(a, b) + 1e-6; }
+bool densitiesAgree(double a, double b) {
+  return std::abs(a - b) <= 1e-3 * std::max(a, b) + 1e-6;
+}
 
 // ---------------------------------------------------------------------------------------------
 // Materials.
@@ -439,7 +444,9 @@ SurfaceHit flatHit() {
   return hit;
 }
 
-std::shared_ptr<const Texture> constant(const Color& c) { return std::make_shared<ConstantTexture>(c); }
+std::shared_ptr<const Texture> constant(const Color& c) {
+  return std::make_shared<ConstantTexture>(c);
+}
 
 // Material sampling: the non-delta samples must follow pdf(wo, wi); delta samples and absorbed
 // paths count as failed (pdf integrates to the probability of a non-delta, non-absorbed sample).
@@ -529,13 +536,16 @@ void sphereFrom(float distanceInRadii, bool flipped, uint64_t seed) {
   std::unique_ptr<Shape> shape = std::make_unique<Sphere>(kSphereCenter, kSphereRadius);
   if (flipped) shape = std::make_unique<FlippedShape>(std::move(shape));
   const Vec3 ref = kSphereCenter + distanceInRadii * kSphereRadius * kOffAxis;
-  const SphereGrid grid = distanceInRadii > 1.0f ? zoomedGrid(ref, kSphereCenter, kSphereRadius) : tiltedGrid();
+  const SphereGrid grid =
+      distanceInRadii > 1.0f ? zoomedGrid(ref, kSphereCenter, kSphereRadius) : tiltedGrid();
   runShape(*shape, ref, grid, seed);
 }
 
 // A frame to place planar shapes and the box in no special orientation.
 const Frame kPlacement(glm::normalize(Vec3(0.3f, -0.5f, 0.8f)));
-Vec3 placed(const Vec3& origin, float x, float y) { return origin + x * kPlacement.s + y * kPlacement.t; }
+Vec3 placed(const Vec3& origin, float x, float y) {
+  return origin + x * kPlacement.s + y * kPlacement.t;
+}
 
 double boundingRadius(const std::vector<Vec3>& pts, Vec3& center) {
   center = Vec3(0.0f);
@@ -743,12 +753,12 @@ const std::vector<Chi2Case>& allCases() {
     };
 
     // Outgoing directions: near the normal, oblique, grazing, and below the surface (two-sided).
-    const Vec3 woNormal(0.05f, 0.02f, 1.0f), woOblique(0.6f, -0.3f, 0.74f),
-        woGrazing(0.95f, 0.1f, 0.25f), woBelow(-0.3f, 0.5f, -0.8f);
+    const Vec3 woNormal(0.05f, 0.02f, 1.0f), woOblique(0.6f, -0.3f, 0.74f), woGrazing(0.95f, 0.1f, 0.25f),
+        woBelow(-0.3f, 0.5f, -0.8f);
 
     // Lambertian.
-    for (const auto& [name, wo] : {std::pair{"Normal", woNormal}, std::pair{"Oblique", woOblique},
-                                   std::pair{"Below", woBelow}}) {
+    for (const auto& [name, wo] :
+         {std::pair{"Normal", woNormal}, std::pair{"Oblique", woOblique}, std::pair{"Below", woBelow}}) {
       add(std::string("Lambertian_wo") + name, [wo](uint64_t s) {
         runMaterial(std::make_shared<Lambertian>(constant(Color(0.7f, 0.5f, 0.3f))), wo, s);
       });
@@ -828,7 +838,8 @@ const std::vector<Chi2Case>& allCases() {
       const auto v = triangleVertices();
       const Triangle tri(v, {Vec2(0, 0), Vec2(1, 0), Vec2(0, 1)});
       const Vec3 n = glm::normalize(glm::cross(v[1] - v[0], v[2] - v[0]));
-      flatShape(tri, {v.begin(), v.end()}, (v[0] + v[1] + v[2]) / 3.0f + 0.9f * n + Vec3(0.3f, 0.0f, 0.0f), s);
+      flatShape(tri, {v.begin(), v.end()}, (v[0] + v[1] + v[2]) / 3.0f + 0.9f * n + Vec3(0.3f, 0.0f, 0.0f),
+                s);
     });
     add("Triangle_back", [](uint64_t s) {
       const auto v = triangleVertices();
@@ -870,8 +881,8 @@ const std::vector<Chi2Case>& allCases() {
     add("Cone_capped_inside", [](uint64_t s) {
       const Vec3 base(0.0f), apex(0.3f, 1.2f, -0.4f);
       const Cone cone(base, apex, 0.7f, true);
-      runShape(cone, base + 0.25f * (apex - base) + 0.1f * Frame(glm::normalize(apex - base)).s,
-               tiltedGrid(), s);
+      runShape(cone, base + 0.25f * (apex - base) + 0.1f * Frame(glm::normalize(apex - base)).s, tiltedGrid(),
+               s);
     });
     add("Box_rotated_inside", [](uint64_t s) {
       const glm::mat3 rot(kPlacement.s, kPlacement.t, kPlacement.n);

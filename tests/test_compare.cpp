@@ -52,7 +52,8 @@ TEST(CompareFlip, ZeroForIdenticalImagesAndLargeForOpposites) {
   for (int y = 0; y < 24; ++y)
     for (int x = 0; x < 24; ++x) a.set(x, y, Color(float(x) / 23.0f, float(y) / 23.0f, 0.5f));
   EXPECT_NEAR(computeFlip(a, a).mean, 0.0, 1e-6);
-  const double blackWhite = computeFlip(constantImage(24, 24, Color(0.0f)), constantImage(24, 24, Color(1.0f))).mean;
+  const double blackWhite =
+      computeFlip(constantImage(24, 24, Color(0.0f)), constantImage(24, 24, Color(1.0f))).mean;
   EXPECT_GT(blackWhite, 0.9);
   EXPECT_LE(blackWhite, 1.0);
   // More difference, more error.
@@ -93,11 +94,14 @@ TEST(CompareCommand, ExitCodes) {
 
   // The z-test: variance and stderr images of zeros demand exact equality.
   writeExr(dir.file("zero.exr"), constantImage(8, 8, Color(0.0f)));
-  const std::string z = " --variance '" + dir.file("zero.exr") + "' --ref-stderr '" + dir.file("zero.exr") + "'";
+  const std::string z =
+      " --variance '" + dir.file("zero.exr") + "' --ref-stderr '" + dir.file("zero.exr") + "'";
   EXPECT_EQ(test::runEmber("compare '" + same + "' '" + ref + "'" + z).exitCode, 0);
   EXPECT_EQ(test::runEmber("compare '" + other + "' '" + ref + "'" + z).exitCode, 1);
   // The heatmap is written.
-  EXPECT_EQ(test::runEmber("compare '" + other + "' '" + ref + "' --heatmap '" + dir.file("h.png") + "'").exitCode, 0);
+  EXPECT_EQ(
+      test::runEmber("compare '" + other + "' '" + ref + "' --heatmap '" + dir.file("h.png") + "'").exitCode,
+      0);
   EXPECT_TRUE(std::filesystem::exists(dir.file("h.png")));
 }
 

@@ -26,15 +26,15 @@ std::string sharedModel(const std::string& relative) {
   return dir + "/" + relative;
 }
 
-#define REQUIRE_SHARED_MODEL(var, rel)                                                      \
-  const std::string var = sharedModel(rel);                                                 \
-  if (var.empty()) GTEST_SKIP() << "shared glTF models not found at " << test::sharedGltfDir() \
-                                << " (set EMBER_SHARED_GLTF); they are not part of the repository";
+#define REQUIRE_SHARED_MODEL(var, rel)                                          \
+  const std::string var = sharedModel(rel);                                     \
+  if (var.empty())                                                              \
+    GTEST_SKIP() << "shared glTF models not found at " << test::sharedGltfDir() \
+                 << " (set EMBER_SHARED_GLTF); they are not part of the repository";
 
-#define REQUIRE_ASSIMP_MODELS()                                                                 \
-  if (!fs::is_directory(test::assimpGltfDir()))                                                 \
-  GTEST_SKIP() << "Debian package assimp-testmodels is not installed (" << test::assimpGltfDir() \
-               << ")"
+#define REQUIRE_ASSIMP_MODELS()                 \
+  if (!fs::is_directory(test::assimpGltfDir())) \
+  GTEST_SKIP() << "Debian package assimp-testmodels is not installed (" << test::assimpGltfDir() << ")"
 
 double meanLuminance(const std::string& path, int width, int height, int spp) {
   Scene scene = loadScene(path);
@@ -117,7 +117,8 @@ TEST(Gltf, MeshEntryInJsonSceneAppliesTransform) {
   const std::string model = test::assimpGltfDir() + "/BoxTextured-glTF-Embedded/BoxTextured.gltf";
   const std::string json = R"({"camera": {"origin": [0, 0, 6], "target": [0, 0, 0]},
     "materials": {"grey": {"type": "diffuse", "reflectance": 0.5}},
-    "shapes": [{"type": "mesh", "file": ")" + model + R"(", "material": "grey",
+    "shapes": [{"type": "mesh", "file": ")" +
+                           model + R"(", "material": "grey",
                 "transform": {"translate": [10, 0, 0], "scale": 2}}]})";
   Scene scene = loadScene(dir.write("s.json", json));
   ASSERT_FALSE(scene.meshes.empty());
@@ -148,7 +149,8 @@ void expectCleanFailure(const BrokenFile& f) {
   }
   TempDir dir;
   const std::string out = dir.file("out.exr");
-  const auto r = test::runEmber("render '" + f.path + "' -o '" + out + "' --png '" + dir.file("o.png") + "' -q --spp 1");
+  const auto r =
+      test::runEmber("render '" + f.path + "' -o '" + out + "' --png '" + dir.file("o.png") + "' -q --spp 1");
   EXPECT_NE(r.exitCode, 0) << f.path;
   EXPECT_LT(r.exitCode, 128) << f.path << " crashed: " << r.output;
   EXPECT_NE(r.output.find(f.expected), std::string::npos) << r.output;
@@ -197,7 +199,8 @@ TEST(Gltf, MissingBinFailsCleanly) {
   REQUIRE_ASSIMP_MODELS();
   TempDir src;  // the .gltf and its texture, without the .bin it references
   fs::copy_file(test::assimpGltfDir() + "/BoxTextured-glTF/BoxTextured.gltf", src.file("BoxTextured.gltf"));
-  fs::copy_file(test::assimpGltfDir() + "/BoxTextured-glTF/CesiumLogoFlat.png", src.file("CesiumLogoFlat.png"));
+  fs::copy_file(test::assimpGltfDir() + "/BoxTextured-glTF/CesiumLogoFlat.png",
+                src.file("CesiumLogoFlat.png"));
   expectCleanFailure({src.file("BoxTextured.gltf"), "BoxTextured0.bin"});
 }
 

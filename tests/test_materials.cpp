@@ -93,8 +93,7 @@ SurfaceHit flatHit() {
 
 Vec3 direction(float thetaDeg, float phi, bool above) {
   const float th = thetaDeg * kPi / 180.0f;
-  return {std::sin(th) * std::cos(phi), std::sin(th) * std::sin(phi),
-          (above ? 1.0f : -1.0f) * std::cos(th)};
+  return {std::sin(th) * std::cos(phi), std::sin(th) * std::sin(phi), (above ? 1.0f : -1.0f) * std::cos(th)};
 }
 
 // wo at 0, 30, 60 and 85 degrees from the normal, above and below the surface.
@@ -105,7 +104,9 @@ std::vector<Vec3> woDirections() {
   return dirs;
 }
 
-std::shared_ptr<const Texture> constant(const Color& c) { return std::make_shared<ConstantTexture>(c); }
+std::shared_ptr<const Texture> constant(const Color& c) {
+  return std::make_shared<ConstantTexture>(c);
+}
 
 struct MaterialCase {
   std::string name;
@@ -144,7 +145,9 @@ std::vector<MaterialCase> materialCases() {
 
 // Energy carried by one sample: the weight with refraction's radiance scaling 1 / eta^2 removed
 // (Veach 1997, section 5.2), so that a lossless interface carries exactly 1.
-Color fluxWeight(const BsdfSample& s) { return s.weight * (s.eta * s.eta); }
+Color fluxWeight(const BsdfSample& s) {
+  return s.weight * (s.eta * s.eta);
+}
 
 // Runs sample() n times, returning per-channel means of the flux weight (failures count 0).
 ColorMean sampledFlux(const Material& m, const SurfaceHit& hit, const Vec3& wo, Rng& rng, int n,
@@ -204,11 +207,17 @@ TEST(MaterialEnergy, MatchesClosedFormAlbedos) {
       {"refraction", std::make_shared<Refraction>(kTransmittance, kIor, 1.0f), kTransmittance,
        woDirections()},
       {"dielectric", std::make_shared<Dielectric>(kIor, 1.0f), Color(1.0f), woDirections()},
-      {"phong", std::make_shared<Phong>(constant(kPhongKd), kPhongKs, 20.0f), kPhongKd + kPhongKs,
+      {"phong",
+       std::make_shared<Phong>(constant(kPhongKd), kPhongKs, 20.0f),
+       kPhongKd + kPhongKs,
        {normal, -normal}},
-      {"phong kd+ks=1 n=1000", std::make_shared<Phong>(constant(Color(0.3f)), Color(0.7f), 1000.0f),
-       Color(1.0f), {normal, -normal}},
-      {"mixed", std::make_shared<Mixed>(mixed), mixed.kd->eval({}) + mixed.ks + mixed.kr + mixed.kt,
+      {"phong kd+ks=1 n=1000",
+       std::make_shared<Phong>(constant(Color(0.3f)), Color(0.7f), 1000.0f),
+       Color(1.0f),
+       {normal, -normal}},
+      {"mixed",
+       std::make_shared<Mixed>(mixed),
+       mixed.kd->eval({}) + mixed.ks + mixed.kr + mixed.kt,
        {normal, -normal}},
   };
   for (const Case& c : cases) {
@@ -272,9 +281,8 @@ TEST(MaterialSampling, PdfAndWeightMatchEvalAndPdf) {
                         wo.z * s.wi.z > 0.0f;  // a reflection
         if (!ok) {
           ++failures;
-          ADD_FAILURE() << "wi " << str(s.wi) << ": sample pdf " << s.pdf << ", pdf() " << pdf
-                        << ", weight " << str(s.weight) << ", eval / pdf " << str(f / s.pdf)
-                        << ", eta " << s.eta;
+          ADD_FAILURE() << "wi " << str(s.wi) << ": sample pdf " << s.pdf << ", pdf() " << pdf << ", weight "
+                        << str(s.weight) << ", eval / pdf " << str(f / s.pdf) << ", eta " << s.eta;
         }
       }
       EXPECT_GT(nonDelta, 0);
@@ -385,7 +393,7 @@ double fresnelTolerance(double cosI, double eta) {
 }
 
 TEST(FresnelDielectric, NormalIncidence) {
-  EXPECT_NEAR(fresnelDielectric(1.0f, 1.5f), 0.04f, kFloatTol * 0.04f);  // ((n - 1) / (n + 1))^2
+  EXPECT_NEAR(fresnelDielectric(1.0f, 1.5f), 0.04f, kFloatTol * 0.04f);         // ((n - 1) / (n + 1))^2
   EXPECT_NEAR(fresnelDielectric(1.0f, 1.0f / 1.5f), 0.04f, kFloatTol * 0.04f);  // same from inside
   EXPECT_NEAR(fresnelDielectric(1.0f, 1.0f), 0.0f, kFloatTol);                  // no interface
   EXPECT_NEAR(fresnelDielectric(0.3f, 1.0f), 0.0f, kFloatTol);

@@ -18,6 +18,8 @@ inline std::string sharedGltfDir() {
 }
 
 // Debian's assimp-testmodels package: valid and deliberately broken glTF files.
-inline std::string assimpGltfDir() { return "/usr/share/assimp/models/glTF2"; }
+inline std::string assimpGltfDir() {
+  return "/usr/share/assimp/models/glTF2";
+}
 
 }  // namespace ember::test

@@ -7,11 +7,11 @@
 // The power tests change the scene slightly (a brighter light, swapped wall colours, a moved
 // sphere) and require the same comparison to fail.
 #include "accel/sphere.h"
-#include "materials/lambertian.h"
 #include "io/image_compare.h"
 #include "io/image_io.h"
 #include "io/image_metrics.h"
 #include "io/scene_loader.h"
+#include "materials/lambertian.h"
 #include "renderer/path_integrator.h"
 #include "renderer/render.h"
 #include "test_paths.h"
@@ -70,7 +70,8 @@ Rendered average(const Rendered& a, const Rendered& b) {
 std::string describe(const BlockZTestResult& r) {
   return std::to_string(r.failures) + "/" + std::to_string(r.tests) + " blocks beyond |z| > " +
          std::to_string(r.threshold) + ", max |z| " + std::to_string(r.maxAbsZ) + ", image-mean z (" +
-         std::to_string(r.meanZ[0]) + ", " + std::to_string(r.meanZ[1]) + ", " + std::to_string(r.meanZ[2]) + ")";
+         std::to_string(r.meanZ[0]) + ", " + std::to_string(r.meanZ[1]) + ", " + std::to_string(r.meanZ[2]) +
+         ")";
 }
 
 class ReferenceImage : public ::testing::TestWithParam<std::string> {};
@@ -94,8 +95,8 @@ TEST_P(ReferenceImage, MatchesMitsubaWithinNoise) {
   Image refStderr = ref.variance;
   for (float& v : refStderr.rgb) v = std::sqrt(v);
   const PixelZTest z = pixelZTest(both.mean, both.variance, ref.mean, refStderr, kAlpha);
-  EXPECT_TRUE(z.passed()) << name << ": " << z.rejected << " of " << z.tests << " pixel-channels beyond |z| > "
-                          << z.threshold << ", max |z| " << z.maxAbsZ;
+  EXPECT_TRUE(z.passed()) << name << ": " << z.rejected << " of " << z.tests
+                          << " pixel-channels beyond |z| > " << z.threshold << ", max |z| " << z.maxAbsZ;
   std::printf("[ %s ] per-pixel z-test: %zu of %zu rejected (|z| > %.3f), max |z| %.3f\n", name.c_str(),
               z.rejected, z.tests, z.threshold, z.maxAbsZ);
 }
@@ -177,7 +178,8 @@ TEST(ReferenceImagePower, FailsWhenThePointLightIsTwoPercentBrighter) {
 
 TEST(ReferenceImagePower, FailsWhenTheWhiteAlbedoChangesByOnePercent) {
   const auto r = compareMutated("shapes", [](Scene& s) {
-    const Material* whiter = s.addMaterial("whiter", std::make_unique<Lambertian>(std::make_shared<ConstantTexture>(Color(0.75f * 1.01f))));
+    const Material* whiter = s.addMaterial(
+        "whiter", std::make_unique<Lambertian>(std::make_shared<ConstantTexture>(Color(0.75f * 1.01f))));
     for (const char* wall : {"floor", "ceiling", "back_wall"}) shapeNamed(s, wall).material = whiter;
   });
   EXPECT_FALSE(r.passes()) << describe(r);

@@ -2,9 +2,9 @@
 // dropped and counted, and two closed-form answers (a convex Lambertian object under a uniform
 // environment; a Lambertian plane under a point light).
 #include "accel/box.h"
+#include "accel/cylinder.h"
 #include "accel/disc.h"
 #include "accel/flipped_shape.h"
-#include "accel/cylinder.h"
 #include "accel/sphere.h"
 #include "accel/triangle.h"
 #include "io/scene_loader.h"
@@ -83,7 +83,9 @@ TEST(Render, NonFiniteSamplesAreDroppedAndCounted) {
   for (float v : img.rgb) ASSERT_EQ(v, 1.0f);  // only the finite samples, each exactly 1
 }
 
-std::shared_ptr<const Texture> grey(float v) { return std::make_shared<ConstantTexture>(Color(v)); }
+std::shared_ptr<const Texture> grey(float v) {
+  return std::make_shared<ConstantTexture>(Color(v));
+}
 
 // A convex Lambertian object of albedo rho alone under a uniform environment of radiance 1
 // reflects exactly rho (irradiance pi, BRDF rho / pi, nothing to interreflect with); the
@@ -92,7 +94,8 @@ TEST(Render, ConvexObjectUnderUniformEnvironmentReflectsItsAlbedo) {
   constexpr float kAlbedo = 0.6f;
   std::vector<std::unique_ptr<Shape>> shapes;
   shapes.push_back(std::make_unique<Sphere>(Vec3(0.0f), 0.8f));
-  shapes.push_back(std::make_unique<Box>(Vec3(0.0f), Vec3(0.9f), glm::mat3(glm::rotate(Mat4(1.0f), 0.5f, Vec3(1, 1, 0)))));
+  shapes.push_back(
+      std::make_unique<Box>(Vec3(0.0f), Vec3(0.9f), glm::mat3(glm::rotate(Mat4(1.0f), 0.5f, Vec3(1, 1, 0)))));
   shapes.push_back(std::make_unique<Cylinder>(Vec3(0.0f, -0.6f, 0.0f), Vec3(0.1f, 0.6f, 0.3f), 0.5f, true));
   for (auto& shape : shapes) {
     const std::string type(shape->typeName());
@@ -137,10 +140,12 @@ TEST(Render, PlaneUnderPointLightMatchesAnalyticIrradiance) {
   scene.settings.maxDepth = 2;
   scene.cameraParams = CameraParams{Vec3(0, 1, 0), Vec3(0, 0, 0), Vec3(0, 0, -1), 0.05f};
   const Material* m = scene.addMaterial("grey", std::make_unique<Lambertian>(grey(kAlbedo)));
-  scene.shapes.push_back({"floor",
-                          std::make_unique<Quad>(std::array<Vec3, 4>{Vec3(-5, 0, 5), Vec3(5, 0, 5), Vec3(5, 0, -5), Vec3(-5, 0, -5)},
-                                                 std::array<Vec2, 4>{Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)}),
-                          m, Color(0.0f)});
+  scene.shapes.push_back(
+      {"floor",
+       std::make_unique<Quad>(
+           std::array<Vec3, 4>{Vec3(-5, 0, 5), Vec3(5, 0, 5), Vec3(5, 0, -5), Vec3(-5, 0, -5)},
+           std::array<Vec2, 4>{Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)}),
+       m, Color(0.0f)});
   scene.lights.push_back(std::make_unique<PointLight>(light, Color(kIntensity)));
   scene.build();
   const Image img = renderWith(scene, 64, 1, 5);
@@ -178,7 +183,9 @@ TEST(Render, WhiteFurnaceConvergesToTheGeometricSeries) {
     scene.settings.height = 16;
     scene.cameraParams = CameraParams{Vec3(0.1f, -0.2f, 0.3f), Vec3(1, 0, 0), Vec3(0, 1, 0), 90.0f};
     const Material* m = scene.addMaterial("grey", std::make_unique<Lambertian>(grey(rho)));
-    scene.shapes.push_back({"furnace", std::make_unique<FlippedShape>(std::make_unique<Sphere>(Vec3(0.0f), 1.0f)), m, Color(kLe)});
+    scene.shapes.push_back({"furnace",
+                            std::make_unique<FlippedShape>(std::make_unique<Sphere>(Vec3(0.0f), 1.0f)), m,
+                            Color(kLe)});
     scene.build();
     const PathIntegrator integrator(-1, 5);
     Film film(16, 16);
@@ -205,11 +212,14 @@ TEST(Render, PlaneOnTheAxisOfADiscLightMatchesTheViewFactor) {
   scene.cameraParams = CameraParams{Vec3(2.0f, 0.8f, 0.0f), Vec3(0.0f), Vec3(0, 1, 0), 0.02f};
   const Material* m = scene.addMaterial("grey", std::make_unique<Lambertian>(grey(kAlbedo)));
   const Material* black = scene.addMaterial("black", std::make_unique<Lambertian>(grey(0.0f)));
-  scene.shapes.push_back({"floor",
-                          std::make_unique<Quad>(std::array<Vec3, 4>{Vec3(-5, 0, 5), Vec3(5, 0, 5), Vec3(5, 0, -5), Vec3(-5, 0, -5)},
-                                                 std::array<Vec2, 4>{Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)}),
-                          m, Color(0.0f)});
-  scene.shapes.push_back({"light", std::make_unique<Disc>(Vec3(0.0f, kHeight, 0.0f), Vec3(0, -1, 0), kRadius), black, Color(kRadiance)});
+  scene.shapes.push_back(
+      {"floor",
+       std::make_unique<Quad>(
+           std::array<Vec3, 4>{Vec3(-5, 0, 5), Vec3(5, 0, 5), Vec3(5, 0, -5), Vec3(-5, 0, -5)},
+           std::array<Vec2, 4>{Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)}),
+       m, Color(0.0f)});
+  scene.shapes.push_back({"light", std::make_unique<Disc>(Vec3(0.0f, kHeight, 0.0f), Vec3(0, -1, 0), kRadius),
+                          black, Color(kRadiance)});
   scene.build();
   const PathIntegrator integrator(-1, 5);
   Film film(2, 2);

@@ -42,7 +42,8 @@ TEST(Sampler, SobolPairsAreZeroMTwoNets) {
           ASSERT_LT(p.y, 1.0f);
           ++count[size_t(int(p.y * float(ny)) * nx + int(p.x * float(nx)))];
         }
-        for (int c : count) ASSERT_EQ(c, 1) << "pixel " << pixel << " pair " << pair << " intervals " << nx << "x" << ny;
+        for (int c : count)
+          ASSERT_EQ(c, 1) << "pixel " << pixel << " pair " << pair << " intervals " << nx << "x" << ny;
       }
     }
 }

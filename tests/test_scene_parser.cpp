@@ -59,26 +59,41 @@ struct BadCase {
 
 TEST(SceneParser, BadInputNamesFileAndPath) {
   const BadCase cases[] = {
-      {"negative radius", variant("\"radius\": 0.5", "\"radius\": -0.5"), "shapes[3].radius: expected a number > 0"},
-      {"radius as string", variant("\"radius\": 0.5", "\"radius\": \"big\""), "shapes[3].radius: expected a number > 0"},
+      {"negative radius", variant("\"radius\": 0.5", "\"radius\": -0.5"),
+       "shapes[3].radius: expected a number > 0"},
+      {"radius as string", variant("\"radius\": 0.5", "\"radius\": \"big\""),
+       "shapes[3].radius: expected a number > 0"},
       {"unknown shape key", variant("\"radius\": 0.5", "\"radius\": 0.5, \"colour\": 1"),
-       "shapes[3].colour: unknown key; valid keys for this shape are: type, id, name, material, emission, flip_normals, center, radius"},
-      {"unknown top-level key", variant("\"render\"", "\"rendr\""), "rendr: unknown key; valid keys here are: image, camera, render"},
+       "shapes[3].colour: unknown key; valid keys for this shape are: type, id, name, material, emission, "
+       "flip_normals, center, radius"},
+      {"unknown top-level key", variant("\"render\"", "\"rendr\""),
+       "rendr: unknown key; valid keys here are: image, camera, render"},
       {"unknown material", variant("\"material\": \"white\"}", "\"material\": \"snow\"}"),
        "shapes[0].material: unknown material 'snow'; defined materials are: white"},
-      {"unknown shape type", variant("\"type\": \"sphere\"", "\"type\": \"torus\""), "shapes[0].type: unknown shape type 'torus'"},
-      {"unknown material type", variant("\"type\": \"diffuse\"", "\"type\": \"velvet\""), "materials.white.type: unknown material type 'velvet'"},
+      {"unknown shape type", variant("\"type\": \"sphere\"", "\"type\": \"torus\""),
+       "shapes[0].type: unknown shape type 'torus'"},
+      {"unknown material type", variant("\"type\": \"diffuse\"", "\"type\": \"velvet\""),
+       "materials.white.type: unknown material type 'velvet'"},
       {"missing camera", variant("\"camera\"", "\"camera_\""), "camera_: unknown key"},
-      {"vector of two", variant("\"center\": [0, 0, 0]", "\"center\": [0, 0]"), "shapes[0].center: expected an array of 3 numbers"},
-      {"negative emission", variant("\"emission\": [1, 1, 1]", "\"emission\": [1, -1, 1]"), "shapes[1].emission[1]: expected a number >= 0"},
-      {"zero normal", variant("\"normal\": [0, 1, 0]", "\"normal\": [0, 0, 0]"), "shapes[2].normal: expected a non-zero direction"},
+      {"vector of two", variant("\"center\": [0, 0, 0]", "\"center\": [0, 0]"),
+       "shapes[0].center: expected an array of 3 numbers"},
+      {"negative emission", variant("\"emission\": [1, 1, 1]", "\"emission\": [1, -1, 1]"),
+       "shapes[1].emission[1]: expected a number >= 0"},
+      {"zero normal", variant("\"normal\": [0, 1, 0]", "\"normal\": [0, 0, 0]"),
+       "shapes[2].normal: expected a non-zero direction"},
       {"non-integer spp", variant("\"spp\": 2", "\"spp\": 2.5"), "render.spp: expected an integer in [1, "},
-      {"huge number", variant("\"radius\": 0.5", "\"radius\": 1e39"), "shapes[3].radius: expected a finite number"},
-      {"phong energy", variant("\"type\": \"diffuse\", \"reflectance\": [0.5, 0.5, 0.5]", "\"type\": \"phong\", \"kd\": 0.6, \"ks\": 0.6"),
+      {"huge number", variant("\"radius\": 0.5", "\"radius\": 1e39"),
+       "shapes[3].radius: expected a finite number"},
+      {"phong energy",
+       variant("\"type\": \"diffuse\", \"reflectance\": [0.5, 0.5, 0.5]",
+               "\"type\": \"phong\", \"kd\": 0.6, \"ks\": 0.6"),
        "materials.white: kd + ks must be <= 1"},
-      {"missing texture", variant("\"reflectance\": [0.5, 0.5, 0.5]", "\"reflectance\": {\"texture\": \"nope.png\"}"),
+      {"missing texture",
+       variant("\"reflectance\": [0.5, 0.5, 0.5]", "\"reflectance\": {\"texture\": \"nope.png\"}"),
        "materials.white.reflectance.texture: "},
-      {"missing mesh file", variant("\"type\": \"sphere\", \"center\": [2, 0, 0], \"radius\": 0.5,", "\"type\": \"mesh\", \"file\": \"nope.glb\","),
+      {"missing mesh file",
+       variant("\"type\": \"sphere\", \"center\": [2, 0, 0], \"radius\": 0.5,",
+               "\"type\": \"mesh\", \"file\": \"nope.glb\","),
        "shapes[3].file: "},
       {"syntax error", variant("\"spp\": 2}", "\"spp\": 2"), "invalid JSON"},
   };
@@ -86,7 +101,8 @@ TEST(SceneParser, BadInputNamesFileAndPath) {
     TempDir dir;
     const std::string path = dir.write("bad.json", c.json);
     const std::string message = loadError(path);
-    EXPECT_EQ(message.rfind(path + ": ", 0), 0u) << c.name << ": message does not start with the file: " << message;
+    EXPECT_EQ(message.rfind(path + ": ", 0), 0u)
+        << c.name << ": message does not start with the file: " << message;
     EXPECT_NE(message.find(c.expected), std::string::npos) << c.name << ": got \"" << message << "\"";
   }
 }
@@ -106,7 +122,8 @@ TEST(CommandLine, BadSceneExitsNonZeroAndWritesNothing) {
   TempDir dir;
   const std::string scene = dir.write("bad.json", variant("\"radius\": 0.5", "\"radius\": -0.5"));
   const std::string out = dir.file("out.exr");
-  const auto r = test::runEmber("render '" + scene + "' -o '" + out + "' --png '" + dir.file("out.png") + "' -q");
+  const auto r =
+      test::runEmber("render '" + scene + "' -o '" + out + "' --png '" + dir.file("out.png") + "' -q");
   EXPECT_NE(r.exitCode, 0);
   EXPECT_NE(r.output.find("shapes[3].radius: expected a number > 0"), std::string::npos) << r.output;
   EXPECT_FALSE(std::filesystem::exists(out));
@@ -129,7 +146,8 @@ TEST(CommandLine, RenderWritesExrAndPngAndInfoDescribesScene) {
   EXPECT_NE(info.output.find("shapes:     4  disc 1  quad 1  sphere 2"), std::string::npos) << info.output;
   EXPECT_NE(info.output.find("1 point, 1 area, 0 emissive triangles"), std::string::npos) << info.output;
 
-  const auto tm = test::runEmber("tonemap '" + dir.file("a.exr") + "' -o '" + dir.file("b.png") + "' --key 0.3");
+  const auto tm =
+      test::runEmber("tonemap '" + dir.file("a.exr") + "' -o '" + dir.file("b.png") + "' --key 0.3");
   EXPECT_EQ(tm.exitCode, 0) << tm.output;
   EXPECT_TRUE(std::filesystem::exists(dir.file("b.png")));
 }
@@ -142,7 +160,8 @@ TEST(CommandLine, BadArgumentsExitNonZero) {
   EXPECT_NE(test::runEmber("render '" + scene + "' -o '" + dir.file("x.exr") + "' --spp 0").exitCode, 0);
   EXPECT_NE(test::runEmber("render '" + scene + "' -o '" + dir.file("x.exr") + "' --spp -3").exitCode, 0);
   EXPECT_NE(test::runEmber("frobnicate").exitCode, 0);
-  EXPECT_NE(test::runEmber("tonemap '" + dir.file("missing.exr") + "' -o '" + dir.file("m.png") + "'").exitCode, 0);
+  EXPECT_NE(
+      test::runEmber("tonemap '" + dir.file("missing.exr") + "' -o '" + dir.file("m.png") + "'").exitCode, 0);
   EXPECT_FALSE(std::filesystem::exists(dir.file("x.exr")));
   EXPECT_FALSE(std::filesystem::exists(dir.file("m.png")));
   const auto help = test::runEmber("render --help");

@@ -79,9 +79,13 @@ Vec2 next2(Rng& rng) {
   return {a, rng.uniform()};
 }
 
-Ray makeRay(const Vec3& o, const Vec3& d, float tMax = kInfinity) { return Ray{o, glm::normalize(d), tMax}; }
+Ray makeRay(const Vec3& o, const Vec3& d, float tMax = kInfinity) {
+  return Ray{o, glm::normalize(d), tMax};
+}
 
-float scaleOf(const Vec3& p) { return 1.0f + maxComponent(glm::abs(p)); }
+float scaleOf(const Vec3& p) {
+  return 1.0f + maxComponent(glm::abs(p));
+}
 
 std::string str(const Vec3& v) {
   std::ostringstream s;
@@ -114,8 +118,8 @@ void expectHit(const Shape& shape, const Ray& ray, float t, const Vec3& n, std::
 void expectMiss(const Shape& shape, const Ray& ray, float tMin = 0.0f, float tMax = kInfinity) {
   LocalHit hit;
   EXPECT_FALSE(shape.intersect(ray, tMin, tMax, hit))
-      << shape.typeName() << ": unexpected hit at t = " << hit.t << " from " << str(ray.origin)
-      << " along " << str(ray.dir);
+      << shape.typeName() << ": unexpected hit at t = " << hit.t << " from " << str(ray.origin) << " along "
+      << str(ray.dir);
 }
 
 // A grazing or tangent ray: either a miss or a sensible hit (finite t near tExpected, unit normal).
@@ -152,8 +156,7 @@ Vec3 sampleHemisphere(const Vec3& n, Vec2 u) {
 // The shape catalogue, with closed-form area, bounds and surface centroid of each.
 
 struct ShapeCase {
-  ShapeCase(std::string n, std::function<std::unique_ptr<Shape>()> f, bool isClosed, bool isFlat,
-            double a)
+  ShapeCase(std::string n, std::function<std::unique_ptr<Shape>()> f, bool isClosed, bool isFlat, double a)
       : name(std::move(n)), make(std::move(f)), closed(isClosed), flat(isFlat), area(a) {}
 
   std::string name;
@@ -161,10 +164,10 @@ struct ShapeCase {
   bool closed = false;
   bool flat = false;
   double area = 0.0;
-  Bounds bounds;       // exact axis-aligned extents
-  Vec3 centroid{0.0f}; // area-weighted mean position of the surface
-  Vec3 interior{0.0f}; // a point strictly inside (closed shapes)
-  float size = 1.0f;   // characteristic length
+  Bounds bounds;        // exact axis-aligned extents
+  Vec3 centroid{0.0f};  // area-weighted mean position of the surface
+  Vec3 interior{0.0f};  // a point strictly inside (closed shapes)
+  float size = 1.0f;    // characteristic length
 };
 
 // Exact box of a disc: half-extent r sqrt(1 - n_i^2) along axis i.
@@ -180,8 +183,7 @@ std::vector<ShapeCase> shapeCases(const Vec3& off) {
   {
     const Vec3 c = off + Vec3(0.5f, -0.25f, 0.75f);
     const float r = 1.25f;
-    ShapeCase sc{"sphere", [=] { return std::make_unique<Sphere>(c, r); }, true, false,
-                 4.0 * pi * r * r};
+    ShapeCase sc{"sphere", [=] { return std::make_unique<Sphere>(c, r); }, true, false, 4.0 * pi * r * r};
     sc.bounds.extend(c - Vec3(r));
     sc.bounds.extend(c + Vec3(r));
     sc.centroid = c;
@@ -223,8 +225,7 @@ std::vector<ShapeCase> shapeCases(const Vec3& off) {
     const double side = pi * r * std::sqrt(double(r) * r + h * h);
     const double capArea = cap ? pi * r * r : 0.0;
     ShapeCase sc{cap ? "cone (capped)" : "cone (open)",
-                 [=] { return std::make_unique<Cone>(base, apex, r, cap); }, cap, false,
-                 side + capArea};
+                 [=] { return std::make_unique<Cone>(base, apex, r, cap); }, cap, false, side + capArea};
     extendDisc(sc.bounds, base, glm::normalize(apex - base), r);
     sc.bounds.extend(apex);
     // The lateral surface's centroid lies a third of the way from the base to the apex.
@@ -366,8 +367,7 @@ TEST(ShapeAll, RaysFromOutsideHitAimedPoint) {
         continue;
       }
       if (std::abs(hit.t - dist) > tol) {
-        ADD_FAILURE() << "hit at t = " << hit.t << ", expected " << dist << " (point " << str(s.p)
-                      << ")";
+        ADD_FAILURE() << "hit at t = " << hit.t << ", expected " << dist << " (point " << str(s.p) << ")";
         ++failures;
       }
       EXPECT_NEAR(glm::length(hit.ng), 1.0f, kFloatTol);
@@ -625,7 +625,7 @@ TEST(ShapeCone, KnownHits) {
     expectMiss(k, makeRay({5, 0, 1}, {1, 0, 0}));      // behind the origin
     expectMiss(k, makeRay({5, 0, 1}, {-1, 0, 0}), 0.0f, 4.4f);
     expectHit(k, makeRay({5, 0, 1}, {-1, 0, 0}), 5.5f, Vec3(-2, 0, 1), {}, 4.6f);  // tMin: far side
-    expectMiss(k, makeRay({1.6f, 0, -5}, {0, 0, 1}));  // beside the base
+    expectMiss(k, makeRay({1.6f, 0, -5}, {0, 0, 1}));                              // beside the base
     if (cap) {
       // Base: Frame((0,0,-1)) has s = +x, t = -y.
       expectHit(k, makeRay({0.25f, 0, -5}, {0, 0, 1}), 5.0f, {0, 0, -1}, Vec2(0.625f, 0.5f));
@@ -695,8 +695,7 @@ TEST(ShapeBox, GrazingRays) {
   expectGrazingSane(b, local({1, -10, 0}, {0, 1, 0}), 8.0f, 4.0f + 1e-3f);
   expectGrazingSane(b, local({1, -10, 3}, {0, 1, 0}), 8.0f, 4.0f + 1e-3f);
   const Vec3 corner(1, 2, 3);
-  expectGrazingSane(b, local(corner + 5.0f * glm::normalize(Vec3(1, 1, 1)), -Vec3(1, 1, 1)), 5.0f,
-                    1e-3f);
+  expectGrazingSane(b, local(corner + 5.0f * glm::normalize(Vec3(1, 1, 1)), -Vec3(1, 1, 1)), 5.0f, 1e-3f);
   // Axis-aligned in the box's own frame (zero direction components): no division trouble.
   const Box a(c, Vec3(2, 4, 6), glm::mat3(1.0f));
   expectHit(a, makeRay(c + Vec3(0, 0, 10), {0, 0, -1}), 7.0f, {0, 0, 1}, Vec2(0.5f, 0.5f));
@@ -715,9 +714,9 @@ TEST(ShapeTriangle, KnownHitsUvAndMisses) {
   expectHit(t, makeRay({1.5f, 0.25f, 1}, {0, 0, -1}), 1.0f, {0, 0, 1}, Vec2(0.75f, 0.125f));
   expectMiss(t, makeRay({1.5f, 1.5f, 5}, {0, 0, -1}));  // beyond the hypotenuse
   expectMiss(t, makeRay({-0.1f, 0.5f, 5}, {0, 0, -1}));
-  expectMiss(t, makeRay({0.5f, 0.5f, 5}, {0, 0, 1}));   // behind
+  expectMiss(t, makeRay({0.5f, 0.5f, 5}, {0, 0, 1}));  // behind
   expectMiss(t, makeRay({0.5f, 0.5f, 5}, {0, 0, -1}), 0.0f, 4.9f);
-  expectMiss(t, makeRay({-1, 0.5f, 0}, {1, 0, 0}));     // edge-on in its plane
+  expectMiss(t, makeRay({-1, 0.5f, 0}, {1, 0, 0}));  // edge-on in its plane
   expectGrazingSane(t, makeRay({-1, 0.5f, 1e-4f}, {1, 0, -1e-4f}), 1.0f, 0.5f);
 
   const Triangle tuv({Vec3(0, 0, 0), Vec3(2, 0, 0), Vec3(0, 2, 0)},
@@ -775,7 +774,8 @@ TEST(ShapeQuad, SolidAngleSamplingMatchesIntegratedSolidAngle) {
       for (int j = 0; j < M; ++j) {
         const double s = (i + 0.5) / M, t = (j + 0.5) / M;
         auto P = [&](int k) { return glm::dvec3(v[size_t(k)]); };
-        const glm::dvec3 p = (1 - s) * (1 - t) * P(0) + s * (1 - t) * P(1) + s * t * P(2) + (1 - s) * t * P(3);
+        const glm::dvec3 p =
+            (1 - s) * (1 - t) * P(0) + s * (1 - t) * P(1) + s * t * P(2) + (1 - s) * t * P(3);
         const glm::dvec3 ds = (1 - t) * (P(1) - P(0)) + t * (P(2) - P(3));
         const glm::dvec3 dt = (1 - s) * (P(3) - P(0)) + s * (P(2) - P(1));
         const double jac = glm::length(glm::cross(ds, dt));
@@ -883,7 +883,7 @@ void runSpawnTest(const Vec3& offset, uint64_t seed) {
       SurfaceHit h2;
       if (hitsMe(offsetRayOrigin(h.p, h.ng, wr, h.t), wr, h2))
         st.problem("acne: reflected ray re-hit its shape",
-                 "at t = " + std::to_string(h2.t) + ", " + where.str());
+                   "at t = " + std::to_string(h2.t) + ", " + where.str());
       if (!sc.closed) continue;
 
       // (b) straight on and refracted (glass, eta 1.5) into the closed shape.
@@ -893,7 +893,7 @@ void runSpawnTest(const Vec3& offset, uint64_t seed) {
         SurfaceHit h3;
         if (!hitsMe(offsetRayOrigin(h.p, h.ng, win, h.t), win, h3) || glm::dot(win, h3.ng) <= 0.0f) {
           st.problem("leak: ray into the shape did not hit its far side",
-                   "along " + str(win) + ", " + where.str());
+                     "along " + str(win) + ", " + where.str());
           continue;
         }
         SurfaceHit h4;
@@ -913,10 +913,14 @@ void runSpawnTest(const Vec3& offset, uint64_t seed) {
   }
 }
 
-TEST(SpawnEmbree, NoAcneNoLeaksNearOrigin) { runSpawnTest(Vec3(0.0f), 101); }
+TEST(SpawnEmbree, NoAcneNoLeaksNearOrigin) {
+  runSpawnTest(Vec3(0.0f), 101);
+}
 
 // Far from the origin float rounding of hit points grows; the offset scales with |p|.
-TEST(SpawnEmbree, NoAcneNoLeaksFarFromOrigin) { runSpawnTest(Vec3(60.0f, -35.0f, 110.0f), 202); }
+TEST(SpawnEmbree, NoAcneNoLeaksFarFromOrigin) {
+  runSpawnTest(Vec3(60.0f, -35.0f, 110.0f), 202);
+}
 
 }  // namespace
 }  // namespace ember
