@@ -23,6 +23,8 @@
 
 #include <gtest/gtest.h>
 
+#include "mc_mean.h"
+
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -34,34 +36,11 @@
 namespace ember {
 namespace {
 
-constexpr double kSigmas = 5.0;
 constexpr float kFloatTol = 1e-5f;  // a few float ulps, relative
 constexpr double kPiD = std::numbers::pi;
 
-// Mean of i.i.d. samples with its standard error.
-class McMean {
- public:
-  void add(double x) {
-    ++n_;
-    sum_ += x;
-    sumSq_ += x * x;
-  }
-  long count() const { return n_; }
-  double mean() const { return n_ ? sum_ / double(n_) : 0.0; }
-  double standardError() const {
-    if (n_ < 2) return 0.0;
-    const double m = mean();
-    const double var = std::max(0.0, sumSq_ / double(n_) - m * m) * double(n_) / double(n_ - 1);
-    return std::sqrt(var / double(n_));
-  }
-  // Tolerance for comparing the mean with an exact value: kSigmas standard errors plus `exactTol`
-  // for what the variance cannot see (float rounding of a deterministic quantity).
-  double tolerance(double exactTol = 0.0) const { return kSigmas * standardError() + exactTol; }
-
- private:
-  long n_ = 0;
-  double sum_ = 0.0, sumSq_ = 0.0;
-};
+using test::kSigmas;
+using test::McMean;
 
 // One McMean per colour channel.
 struct ColorMean {

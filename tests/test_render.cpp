@@ -34,6 +34,18 @@ Image renderWith(const Scene& scene, int spp, int threads, uint64_t seed, uint64
   return film.mean();
 }
 
+// Renders with the scene's own image size and depth settings, independent sampler.
+Film renderFilm(const Scene& scene, int spp, uint64_t seed, RenderStats* stats = nullptr) {
+  const PathIntegrator integrator(scene.settings.maxDepth, scene.settings.rrDepth);
+  Film film(scene.settings.width, scene.settings.height);
+  RenderOptions options;
+  options.spp = spp;
+  options.seed = seed;
+  const RenderStats s = render(scene, integrator, options, film);
+  if (stats) *stats = s;
+  return film;
+}
+
 Scene smallCornell() {
   Scene scene = loadJsonScene(test::sourcePath("scenes/cornell-area.json"));
   scene.settings.width = 40;
@@ -107,12 +119,7 @@ TEST(Render, ConvexObjectUnderUniformEnvironmentReflectsItsAlbedo) {
     const Material* m = scene.addMaterial("grey", std::make_unique<Lambertian>(grey(kAlbedo)));
     scene.shapes.push_back({type, std::move(shape), m, Color(0.0f)});
     scene.build();
-    const PathIntegrator integrator(-1, 5);
-    Film film(16, 16);
-    RenderOptions options;
-    options.spp = 128;
-    options.seed = 11;
-    render(scene, integrator, options, film);
+    const Film film = renderFilm(scene, 128, 11);
     const Image mean = film.mean(), var = film.varianceOfMean();
     int inside = 0;
     for (int y = 0; y < 16; ++y)
@@ -187,12 +194,8 @@ TEST(Render, WhiteFurnaceConvergesToTheGeometricSeries) {
                             std::make_unique<FlippedShape>(std::make_unique<Sphere>(Vec3(0.0f), 1.0f)), m,
                             Color(kLe)});
     scene.build();
-    const PathIntegrator integrator(-1, 5);
-    Film film(16, 16);
-    RenderOptions options;
-    options.spp = 64;
-    options.seed = 3;
-    const RenderStats stats = render(scene, integrator, options, film);
+    RenderStats stats;
+    const Film film = renderFilm(scene, 64, 3, &stats);
     EXPECT_EQ(stats.nonFinite, 0u);
     const ImageEstimate e = estimate(film);
     const double expected = kLe / (1.0 - rho);
@@ -221,12 +224,7 @@ TEST(Render, PlaneOnTheAxisOfADiscLightMatchesTheViewFactor) {
   scene.shapes.push_back({"light", std::make_unique<Disc>(Vec3(0.0f, kHeight, 0.0f), Vec3(0, -1, 0), kRadius),
                           black, Color(kRadiance)});
   scene.build();
-  const PathIntegrator integrator(-1, 5);
-  Film film(2, 2);
-  RenderOptions options;
-  options.spp = 4096;
-  options.seed = 9;
-  render(scene, integrator, options, film);
+  const Film film = renderFilm(scene, 4096, 9);
   const ImageEstimate e = estimate(film);
   const double expected = kAlbedo * kRadiance * kRadius * kRadius / (kHeight * kHeight + kRadius * kRadius);
   // The pixel footprint spans ~1e-3 around the axis, where the irradiance is flat to ~1e-6.

@@ -28,6 +28,8 @@
 
 #include <gtest/gtest.h>
 
+#include "mc_mean.h"
+
 #include <array>
 #include <cmath>
 #include <functional>
@@ -42,37 +44,11 @@
 namespace ember {
 namespace {
 
-constexpr double kSigmas = 5.0;
 // Relative precision of a float result computed from float inputs (a few ulps of 2^-24).
 constexpr float kFloatTol = 1e-5f;
 
-// Mean of i.i.d. samples with its standard error.
-class McMean {
- public:
-  void add(double x) {
-    ++n_;
-    sum_ += x;
-    sumSq_ += x * x;
-  }
-  long count() const { return n_; }
-  double mean() const { return n_ ? sum_ / double(n_) : 0.0; }
-  double standardError() const {
-    if (n_ < 2) return 0.0;
-    const double m = mean();
-    const double var = std::max(0.0, sumSq_ / double(n_) - m * m) * double(n_) / double(n_ - 1);
-    return std::sqrt(var / double(n_));
-  }
-  // |mean - expected| within kSigmas standard errors, plus `exactTol` for what the variance cannot
-  // see (float rounding of a deterministic quantity).
-  void expectNear(double expected, double exactTol, const std::string& what) const {
-    EXPECT_NEAR(mean(), expected, kSigmas * standardError() + exactTol)
-        << what << " (n = " << n_ << ", stderr = " << standardError() << ")";
-  }
-
- private:
-  long n_ = 0;
-  double sum_ = 0.0, sumSq_ = 0.0;
-};
+using test::kSigmas;
+using test::McMean;
 
 Vec2 next2(Rng& rng) {
   const float a = rng.uniform();
