@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <sstream>
 
 namespace ember::cli {
 
@@ -28,6 +29,7 @@ struct RenderArgs {
   std::optional<uint64_t> seed;
   uint64_t firstSample = 0;
   std::string sampler;
+  std::string env;
   bool quiet = false;
 };
 
@@ -48,6 +50,28 @@ std::string isoTime() {
   return buf;
 }
 
+// --env: "r,g,b" or one number is a constant environment, anything else an equirectangular map.
+void applyEnvironment(const std::string& value, Scene& scene) {
+  std::vector<float> numbers;
+  std::stringstream in(value);
+  std::string part;
+  bool numeric = true;
+  while (numeric && std::getline(in, part, ',')) {
+    char* end = nullptr;
+    const float v = std::strtof(part.c_str(), &end);
+    numeric = end != part.c_str() && *end == '\0' && std::isfinite(v) && v >= 0.0f;
+    numbers.push_back(v);
+  }
+  if (numeric && (numbers.size() == 1 || numbers.size() == 3)) {
+    scene.background = numbers.size() == 1 ? Color(numbers[0]) : Color(numbers[0], numbers[1], numbers[2]);
+    scene.environmentMap = nullptr;
+    return;
+  }
+  if (numeric) throw InputError("--env " + value + ": expected r,g,b or one number >= 0, or an image file");
+  scene.environmentMap = loadEnvironmentMap(value);
+  scene.background = Color(0.0f);
+}
+
 int runRender(const RenderArgs& a) {
   checkOutputPath(a.output, ".exr", "-o");
   if (!a.png.empty()) checkOutputPath(a.png, ".png", "--png");
@@ -61,6 +85,7 @@ int runRender(const RenderArgs& a) {
   if (a.width) s.width = *a.width;
   if (a.height) s.height = *a.height;
   if (a.maxDepth) s.maxDepth = *a.maxDepth;
+  if (!a.env.empty()) applyEnvironment(a.env, scene);
   if (a.sampler == "sobol") s.sampler = SamplerType::Sobol;
   if (a.sampler == "independent") s.sampler = SamplerType::Independent;
   scene.build();
@@ -137,6 +162,9 @@ Runner addRenderCommand(CLI::App& app) {
                   "Random numbers: sobol (Owen-scrambled, the default) or independent; default: the scene's "
                   "render.sampler")
       ->check(CLI::IsMember({"independent", "sobol"}));
+  cmd->add_option("--env", args->env,
+                  "Environment light: r,g,b (or one number) for a constant colour, or an equirectangular "
+                  "EXR/HDR map; replaces the scene's");
   cmd->add_option("--variance", args->variance, "Also write the per-pixel variance of the mean as an EXR");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress display (the summary line is still printed)");
   return [args] { return runRender(*args); };

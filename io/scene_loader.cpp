@@ -38,10 +38,12 @@ class JsonSceneLoader {
       : path_(path), baseDir_(fs::path(path).parent_path()), scene_(scene) {}
 
   void load(const JsonNode& root) {
-    root.allowKeys({"image", "camera", "render", "materials", "shapes", "lights", "description", "name"});
+    root.allowKeys(
+        {"image", "camera", "render", "environment", "materials", "shapes", "lights", "description", "name"});
     if (auto image = root.find("image")) readImage(*image);
     readCamera(root.at("camera"));
     if (auto render = root.find("render")) readRender(*render);
+    if (auto env = root.find("environment")) readEnvironment(*env);
     if (auto materials = root.find("materials")) readMaterials(*materials);
     if (auto shapes = root.find("shapes"))
       for (size_t i = 0; i < shapes->arraySize(); ++i) readShape((*shapes)[i]);
@@ -90,6 +92,27 @@ class JsonSceneLoader {
         sampler->fail("unknown sampler '" + v + "'; valid: independent, sobol");
     }
     scene_.background = n.color("background", Color(0.0f));
+  }
+
+  void readEnvironment(const JsonNode& n) {
+    n.allowKeys({"map", "scale", "rotate_y_deg", "filter"});
+    if (!isBlack(scene_.background)) n.fail("give either render.background or environment, not both");
+    const JsonNode file = n.at("map");
+    TextureFilter filter = TextureFilter::Bilinear;
+    if (auto f = n.find("filter")) {
+      const std::string v = f->string();
+      if (v == "nearest")
+        filter = TextureFilter::Nearest;
+      else if (v != "bilinear")
+        f->fail("unknown filter '" + v + "'; valid: nearest, bilinear");
+    }
+    try {
+      scene_.environmentMap =
+          loadEnvironmentMap((baseDir_ / file.string()).string(), n.color("scale", Color(1.0f)), filter);
+    } catch (const InputError& e) {
+      file.fail(e.what());
+    }
+    scene_.environmentRotateYDeg = n.number("rotate_y_deg", 0.0f);
   }
 
   std::shared_ptr<const Texture> readTexture(const JsonNode& n) {
@@ -377,6 +400,18 @@ class JsonSceneLoader {
   std::map<std::string, const Material*> materials_;
   const Material* black_ = nullptr;
 };
+
+}  // namespace
+
+std::shared_ptr<const ImageTexture> loadEnvironmentMap(const std::string& path, const Color& scale,
+                                                       TextureFilter filter) {
+  TextureImage img = readTexture(path, ColorEncoding::Auto);
+  // Equirectangular: u wraps around, v (the poles) clamps.
+  return std::make_shared<ImageTexture>(img.width, img.height, std::move(img.texels), filter,
+                                        TextureWrap::Repeat, scale);
+}
+
+namespace {
 
 // A camera that frames the bounds from the front (+z) and a little above.
 CameraParams framingCamera(const Bounds& b, float aspect) {

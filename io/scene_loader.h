@@ -14,4 +14,9 @@ Scene loadJsonScene(const std::string& path);
 
 bool isGltfPath(const std::string& path);
 
+// An equirectangular environment map (EXR/HDR linear; 8-bit files decoded from sRGB), times scale.
+std::shared_ptr<const ImageTexture> loadEnvironmentMap(const std::string& path,
+                                                       const Color& scale = Color(1.0f),
+                                                       TextureFilter filter = TextureFilter::Bilinear);
+
 }  // namespace ember

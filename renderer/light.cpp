@@ -50,17 +50,76 @@ bool TriangleLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
   return out.pdf > 0.0f && std::isfinite(out.pdf);
 }
 
+EnvironmentLight::EnvironmentLight(std::shared_ptr<const ImageTexture> map, float rotateYDeg)
+    : map_(std::move(map)),
+      cosRot_(std::cos(glm::radians(rotateYDeg))),
+      sinRot_(std::sin(glm::radians(rotateYDeg))) {
+  const int w = map_->width(), h = map_->height();
+  std::vector<float> weights(size_t(w) * size_t(h));
+  double sum = 0.0, sinSum = 0.0;
+  Color weighted(0.0f);
+  for (int y = 0; y < h; ++y) {
+    const float sinTheta = std::sin(kPi * (float(y) + 0.5f) / float(h));
+    for (int x = 0; x < w; ++x) {
+      const Color c = map_->eval(Vec2((float(x) + 0.5f) / float(w), (float(y) + 0.5f) / float(h)));
+      weights[size_t(y) * size_t(w) + size_t(x)] = luminance(c) * sinTheta;
+      sum += luminance(c) * sinTheta;
+      weighted += c * sinTheta;
+      sinSum += sinTheta;
+    }
+  }
+  // A floor keeps every direction samplable: bilinear lookups give dark texels next to bright
+  // ones some radiance, which light sampling must be able to reach too.
+  const float floor = float(1e-3 * sum / double(weights.size()));
+  for (float& v : weights) v += floor;
+  distribution_ = Distribution2D(weights, w, h);
+  average_ = sinSum > 0.0 ? weighted / float(sinSum) : Color(0.0f);
+}
+
+Vec2 EnvironmentLight::toUv(const Vec3& d) const {
+  // Turn the world direction into the map's frame (the inverse of the map's rotation about +y).
+  const Vec3 l(cosRot_ * d.x - sinRot_ * d.z, d.y, sinRot_ * d.x + cosRot_ * d.z);
+  float u = 0.5f + std::atan2(l.x, -l.z) / (2.0f * kPi);
+  if (u >= 1.0f) u -= 1.0f;
+  return {u, std::acos(std::clamp(l.y, -1.0f, 1.0f)) * kInvPi};
+}
+
+Vec3 EnvironmentLight::fromUv(Vec2 uv) const {
+  const float phi = 2.0f * kPi * (uv.x - 0.5f), theta = kPi * uv.y;
+  const float s = std::sin(theta);
+  const Vec3 l(s * std::sin(phi), std::cos(theta), -s * std::cos(phi));
+  return {cosRot_ * l.x + sinRot_ * l.z, l.y, -sinRot_ * l.x + cosRot_ * l.z};
+}
+
+Color EnvironmentLight::radiance(const Vec3& dir) const {
+  return map_ ? map_->eval(toUv(dir)) : radiance_;
+}
+
+float EnvironmentLight::pdfDirection(const Vec3& dir) const {
+  if (!map_) return kUniformSpherePdf;
+  const Vec2 uv = toUv(dir);
+  const float sinTheta = std::sin(kPi * uv.y);
+  if (sinTheta <= 0.0f) return 0.0f;
+  // Jacobian of the equirectangular map: d omega = 2 pi^2 sin(theta) du dv.
+  return distribution_.pdf(uv) / (2.0f * kPi * kPi * sinTheta);
+}
+
 bool EnvironmentLight::sample(const Vec3&, Vec2 u, LightSample& out) const {
-  out.wi = sampleUniformSphere(u);
   out.dist = kInfinity;
-  out.pdf = kUniformSpherePdf;
-  out.Li = radiance_;
   out.delta = false;
+  if (!map_) {
+    out.wi = sampleUniformSphere(u);
+    out.pdf = kUniformSpherePdf;
+    out.Li = radiance_;
+    return true;
+  }
+  float pdfUv;
+  const Vec2 uv = distribution_.sample(u, pdfUv);
+  const float sinTheta = std::sin(kPi * uv.y);
+  if (pdfUv <= 0.0f || sinTheta <= 0.0f) return false;
+  out.wi = fromUv(uv);
+  out.pdf = pdfUv / (2.0f * kPi * kPi * sinTheta);
+  out.Li = map_->eval(uv);
   return true;
 }
-
-float EnvironmentLight::pdf(const Vec3&, const Vec3&, const Vec3&) const {
-  return kUniformSpherePdf;
-}
-
 }  // namespace ember

@@ -7,6 +7,10 @@
 
 #include "accel/shape.h"
 #include "accel/triangle_mesh.h"
+#include "materials/texture.h"
+#include "renderer/distribution.h"
+
+#include <memory>
 
 namespace ember {
 
@@ -76,19 +80,34 @@ class TriangleLight final : public Light {
   Color radiance_;
 };
 
+// Radiance arriving from infinitely far away: a constant colour, or an equirectangular map
+// (latitude-longitude: u = 0.5 + atan2(d.x, -d.z) / (2 pi), so u = 0.5 looks along -z; v =
+// acos(d.y) / pi, v = 0 straight up), optionally turned about +y. A map is importance-sampled with a
+// piecewise-constant 2D distribution of texel luminance x sin(theta) (PBRT4 section 12.5.2); the
+// constant one uniformly over the sphere.
 class EnvironmentLight final : public Light {
  public:
-  explicit EnvironmentLight(const Color& radiance) : radiance_(radiance) {}
+  explicit EnvironmentLight(const Color& radiance) : radiance_(radiance), average_(radiance) {}
+  EnvironmentLight(std::shared_ptr<const ImageTexture> map, float rotateYDeg);
+
   bool sample(const Vec3& ref, Vec2 u, LightSample& out) const override;
-  float pdf(const Vec3&, const Vec3&, const Vec3&) const override;
+  float pdf(const Vec3&, const Vec3& dir, const Vec3&) const override { return pdfDirection(dir); }
   // Power through a disc of the scene's radius from every direction (PBRT4 section 12.5.1).
   Color power(float sceneRadius) const override {
-    return 4.0f * kPi * kPi * sceneRadius * sceneRadius * radiance_;
+    return 4.0f * kPi * kPi * sceneRadius * sceneRadius * average_;
   }
-  Color radiance(const Vec3& /*dir*/) const { return radiance_; }
+  Color radiance(const Vec3& dir) const;
+  float pdfDirection(const Vec3& dir) const;
 
  private:
-  Color radiance_;
+  Vec2 toUv(const Vec3& dir) const;
+  Vec3 fromUv(Vec2 uv) const;
+
+  Color radiance_{0.0f};
+  Color average_{0.0f};
+  std::shared_ptr<const ImageTexture> map_;
+  Distribution2D distribution_;
+  float cosRot_ = 1.0f, sinRot_ = 0.0f;
 };
 
 }  // namespace ember

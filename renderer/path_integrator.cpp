@@ -45,7 +45,7 @@ Color PathIntegrator::Li(const Scene& scene, Ray ray, Sampler& sampler, PathStat
       if (const EnvironmentLight* env = scene.environment()) {
         float weight = 1.0f;
         if (!previousDelta)
-          weight = powerHeuristic(previousPdf, lights.pmf(env) * env->pdf(previousPoint, ray.dir, ray.dir));
+          weight = powerHeuristic(previousPdf, lights.pmf(env) * env->pdfDirection(ray.dir));
         radiance += throughput * env->radiance(ray.dir) * weight;
       }
       break;

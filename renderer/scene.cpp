@@ -53,8 +53,11 @@ void Scene::build() {
     bounds_.extend(Vec3(1.0f));
   }
 
-  if (!isBlack(background)) {
-    lights.push_back(std::make_unique<EnvironmentLight>(background));
+  if (environmentMap || !isBlack(background)) {
+    if (environmentMap)
+      lights.push_back(std::make_unique<EnvironmentLight>(environmentMap, environmentRotateYDeg));
+    else
+      lights.push_back(std::make_unique<EnvironmentLight>(background));
     environment_ = static_cast<const EnvironmentLight*>(lights.back().get());
     allLights.push_back(lights.back().get());
   }

@@ -46,6 +46,9 @@ class Scene {
   RenderSettings settings;
   CameraParams cameraParams;
   Color background{0.0f};  // constant environment radiance; black = none
+  // An equirectangular environment map (linear radiance), used instead of `background` when set.
+  std::shared_ptr<const ImageTexture> environmentMap;
+  float environmentRotateYDeg = 0.0f;
   std::vector<std::unique_ptr<Material>> materials;
   std::vector<std::string> materialNames;  // parallel to materials
   std::vector<ShapeEntry> shapes;
