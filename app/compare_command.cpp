@@ -171,8 +171,10 @@ Runner addCompareCommand(CLI::App& app) {
                   "z-test: use max(own, mean over the (2R+1)^2 neighbourhood) as each pixel's variance "
                   "(default 2; 0 = per pixel)")
       ->check(CLI::Range(0, 64));
-  cmd->add_option("--max-relmse", args->maxRelmse, "Fail when relMSE over all channels exceeds this");
-  cmd->add_option("--max-flip", args->maxFlip, "Fail when the FLIP mean exceeds this");
+  cmd->add_option("--max-relmse", args->maxRelmse, "Fail when relMSE over all channels exceeds this")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--max-flip", args->maxFlip, "Fail when the FLIP mean exceeds this")
+      ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--ppd", args->ppd, "FLIP observer resolution in pixels per degree (default 67)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--heatmap", args->heatmap, "Write the FLIP error map as a PNG (magma colours)");

@@ -13,7 +13,7 @@ struct ImageMetrics {
   std::array<double, 3> meanImage{}, meanReference{};
   std::array<double, 3> mae{}, rmse{}, relmse{};
   double maeAll = 0.0, rmseAll = 0.0, relmseAll = 0.0;  // over all channels
-  size_t nonFinite = 0;                                 // image pixels with NaN/inf (excluded)
+  size_t nonFinite = 0;  // pixels where the image or the reference is NaN/inf (excluded)
 };
 
 // relMSE = mean((x - r)^2 / (r^2 + 0.01)), the regularised relative MSE of Rousselle et al. 2011.

@@ -3,9 +3,12 @@
 // every 16x16 block mean and the whole-image mean per channel are z-tested against the reference,
 // the variance coming from the renders' own per-pixel sample variances plus the reference's
 // stderr^2, at a family-wise level of 1% (Sidak-corrected). The two renders are also z-tested
-// against each other, which checks that the variance estimate itself is right.
-// The power tests change the scene slightly (a brighter light, swapped wall colours, a moved
-// sphere) and require the same comparison to fail.
+// against each other, which checks that the variance estimate itself is right. Every pixel and
+// channel is z-tested on its own as well (io/image_metrics.h, variances pooled over 5x5 pixels).
+// The power tests change the scene slightly (a light 2x or 2% brighter, a point light 2% brighter,
+// the white albedo 1% higher, swapped wall colours, a moved sphere) and require the comparison to
+// fail. The Sobol sampler is checked against the references too (conservatively: its samples are
+// not independent, so their sample variance overestimates the noise).
 #include "accel/sphere.h"
 #include "io/image_compare.h"
 #include "io/image_io.h"

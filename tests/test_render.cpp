@@ -1,6 +1,7 @@
 // The renderer as a whole: thread-count independence, sample ranges that merge, non-finite samples
-// dropped and counted, and two closed-form answers (a convex Lambertian object under a uniform
-// environment; a Lambertian plane under a point light).
+// dropped and counted, and closed-form answers: a convex Lambertian object under a uniform
+// environment, a Lambertian plane under a point light, the white furnace (Le / (1 - rho)) and a
+// plane on the axis of a disc light (its view factor).
 #include "accel/box.h"
 #include "accel/cylinder.h"
 #include "accel/disc.h"

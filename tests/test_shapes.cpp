@@ -4,7 +4,8 @@
 // grazing and tangent rays, shapes behind the origin, the (tMin, tMax) interval, exact bounds,
 // area sampling (points on the surface, unit normals equal to the intersection normal, centroid of
 // the samples equal to the surface's centroid), areas against closed forms, and solid-angle
-// sampling (sphere cone sampling; the quad's default area-to-solid-angle conversion).
+// sampling (sphere cone sampling; the quad's solid-angle sampling from far away, which is the
+// area-to-solid-angle conversion; tests/test_chi2.cpp covers the spherical-rectangle case).
 // Through Embree: secondary rays spawned with offsetRayOrigin neither self-intersect (acne) nor
 // leak through closed shapes.
 //
