@@ -94,6 +94,8 @@ class GltfImporter {
     for (int i = 0; i < 16; ++i)
       if (!std::isfinite(world[i / 4][i % 4])) fail(where, "non-finite transform");
     if (node.camera >= 0 && !result_.camera) readCamera(node.camera, world);
+    if (const auto ext = node.extensions.find("KHR_lights_punctual"); ext != node.extensions.end())
+      readLight(ext->second, world, where + ".extensions.KHR_lights_punctual");
     if (node.mesh >= 0) {
       if (size_t(node.mesh) >= model_.meshes.size()) fail(where + ".mesh", "mesh index out of range");
       const tinygltf::Mesh& mesh = model_.meshes[size_t(node.mesh)];
@@ -125,6 +127,37 @@ class GltfImporter {
     if (!(c.fovYDeg > 0.0f && c.fovYDeg < 180.0f) || !isFinite(c.origin) || !isFinite(forward)) return;
     result_.camera = c;
     result_.cameraAspect = float(cam.perspective.aspectRatio);
+  }
+
+  // KHR_lights_punctual, photometric to radiometric with 683 lm/W (docs/gltf.md): point and spot
+  // intensity [cd] / 683 = W/sr, directional illuminance [lux] / 683 = W/m^2. This is exactly the
+  // inverse of Blender's exporter (W / (4 pi) * 683 cd, W/m^2 * 683 lux), so Blender scenes come out
+  // as bright as Blender renders them. `range` is ignored (the spec allows it): lights fall off
+  // with the inverse square law only.
+  void readLight(const tinygltf::Value& ext, const Mat4& world, const std::string& where) {
+    if (!ext.IsObject() || !ext.Has("light") || !ext.Get("light").IsNumber())
+      fail(where, "expected {\"light\": index}");
+    const int index = ext.Get("light").GetNumberAsInt();
+    if (index < 0 || size_t(index) >= model_.lights.size()) fail(where, "light index out of range");
+    const tinygltf::Light& l = model_.lights[size_t(index)];
+    Color color(1.0f);
+    if (l.color.size() == 3) color = Color(float(l.color[0]), float(l.color[1]), float(l.color[2]));
+    const Color radiometric = color * float(l.intensity) / 683.0f;
+    if (!isFinite(radiometric) || radiometric.x < 0.0f || radiometric.y < 0.0f || radiometric.z < 0.0f)
+      fail(where, "light colour and intensity must be finite and >= 0");
+    const Vec3 position(world * glm::vec4(0, 0, 0, 1));
+    const Vec3 direction = glm::normalize(Vec3(world * glm::vec4(0, 0, -1, 0)));  // lights shine along -z
+    if (l.type == "point") {
+      scene_.lights.push_back(std::make_unique<PointLight>(position, radiometric));
+    } else if (l.type == "spot") {
+      scene_.lights.push_back(std::make_unique<SpotLight>(
+          position, direction, radiometric, float(l.spot.innerConeAngle), float(l.spot.outerConeAngle)));
+    } else if (l.type == "directional") {
+      scene_.lights.push_back(std::make_unique<DirectionalLight>(-direction, radiometric));
+    } else {
+      fail(where, "unknown light type '" + l.type + "'; valid: point, spot, directional");
+    }
+    ++result_.lights;
   }
 
   // Reads `count` elements of accessor `index` as floats (normalised integers are converted),

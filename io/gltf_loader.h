@@ -17,6 +17,7 @@ struct GltfImport {
   float cameraAspect = 0.0f;           // its aspectRatio, 0 if unspecified
   size_t triangles = 0;
   size_t primitives = 0;
+  size_t lights = 0;  // KHR_lights_punctual lights placed by nodes
 };
 
 // Appends the file's meshes (transformed by `transform`) and materials to `scene`. With

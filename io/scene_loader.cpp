@@ -389,9 +389,25 @@ class JsonSceneLoader {
 
   void readLight(const JsonNode& l) {
     const std::string type = l.at("type").string();
-    if (type != "point") l.at("type").fail("unknown light type '" + type + "'; valid types are: point");
-    l.allowKeys({"type", "id", "name", "position", "intensity"});
-    scene_.lights.push_back(std::make_unique<PointLight>(l.at("position").vec3(), l.at("intensity").color()));
+    if (type == "point") {
+      l.allowKeys({"type", "id", "name", "position", "intensity"});
+      scene_.lights.push_back(
+          std::make_unique<PointLight>(l.at("position").vec3(), l.at("intensity").color()));
+    } else if (type == "spot") {
+      l.allowKeys({"type", "id", "name", "position", "direction", "intensity", "inner_deg", "outer_deg"});
+      const float outer = l.positive("outer_deg", 45.0f), inner = l.nonNegative("inner_deg", 0.0f);
+      if (!(inner < outer && outer <= 90.0f)) l.fail("expected 0 <= inner_deg < outer_deg <= 90");
+      scene_.lights.push_back(
+          std::make_unique<SpotLight>(l.at("position").vec3(), l.at("direction").direction(),
+                                      l.at("intensity").color(), glm::radians(inner), glm::radians(outer)));
+    } else if (type == "directional") {
+      l.allowKeys({"type", "id", "name", "direction", "irradiance"});
+      // `direction` is where the light travels (glTF's -z of the light node), so it arrives from -direction.
+      scene_.lights.push_back(
+          std::make_unique<DirectionalLight>(-l.at("direction").direction(), l.at("irradiance").color()));
+    } else {
+      l.at("type").fail("unknown light type '" + type + "'; valid types are: point, spot, directional");
+    }
   }
 
   std::string path_;
@@ -443,8 +459,9 @@ Scene loadGltfScene(const std::string& path) {
     scene.settings.width = 512;
     scene.cameraParams = framingCamera(bounds, 512.0f / 384.0f);
   }
-  // glTF files rarely carry lights: a uniform white environment lights them like an overcast sky.
-  scene.background = Color(1.0f);
+  // Without KHR_lights_punctual lights a uniform white environment lights the file like an
+  // overcast sky; with them, the file's own lights alone (`--env` adds an environment).
+  if (imported.lights == 0) scene.background = Color(1.0f);
   return scene;
 }
 

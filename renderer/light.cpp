@@ -17,6 +17,34 @@ bool PointLight::sample(const Vec3& ref, Vec2, LightSample& out) const {
   return true;
 }
 
+SpotLight::SpotLight(const Vec3& position, const Vec3& direction, const Color& intensity, float innerRad,
+                     float outerRad)
+    : position_(position),
+      direction_(glm::normalize(direction)),
+      intensity_(intensity),
+      cosInner_(std::cos(innerRad)),
+      cosOuter_(std::cos(outerRad)) {}
+
+float SpotLight::falloff(float cosAngle) const {
+  // KHR_lights_punctual's recommended implementation, including its guard against inner == outer.
+  const float scale = 1.0f / std::max(0.001f, cosInner_ - cosOuter_);
+  const float a = std::clamp((cosAngle - cosOuter_) * scale, 0.0f, 1.0f);
+  return a * a;
+}
+
+bool SpotLight::sample(const Vec3& ref, Vec2, LightSample& out) const {
+  const Vec3 d = position_ - ref;
+  const float dist2 = glm::dot(d, d);
+  if (dist2 == 0.0f) return false;
+  out.dist = std::sqrt(dist2);
+  out.wi = d / out.dist;
+  out.p = position_;
+  out.Li = intensity_ * (falloff(glm::dot(-out.wi, direction_)) / dist2);
+  out.pdf = 1.0f;
+  out.delta = true;
+  return true;
+}
+
 bool AreaLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
   ShapeSample s;
   float pdf;

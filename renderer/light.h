@@ -49,6 +49,50 @@ class PointLight final : public Light {
   Color intensity_;
 };
 
+// A spot light (glTF KHR_lights_punctual): intensity I [W/sr] along `direction`, fading between
+// the inner and outer cone angles with the glTF specification's smooth falloff:
+// a = clamp((cos - cosOuter) / (cosInner - cosOuter), 0, 1)^2.
+class SpotLight final : public Light {
+ public:
+  SpotLight(const Vec3& position, const Vec3& direction, const Color& intensity, float innerRad,
+            float outerRad);
+  bool sample(const Vec3& ref, Vec2 u, LightSample& out) const override;
+  float pdf(const Vec3&, const Vec3&, const Vec3&) const override { return 0.0f; }
+  // Bounded by the power inside the outer cone.
+  Color power(float) const override { return 2.0f * kPi * (1.0f - cosOuter_) * intensity_; }
+  bool isDelta() const override { return true; }
+  float falloff(float cosAngle) const;
+
+ private:
+  Vec3 position_, direction_;
+  Color intensity_;
+  float cosInner_, cosOuter_;
+};
+
+// A directional light (the sun): irradiance E [W/m^2] on a surface facing it, arriving from the
+// fixed direction `towardsLight`; a delta light reached by next-event estimation only.
+class DirectionalLight final : public Light {
+ public:
+  DirectionalLight(const Vec3& towardsLight, const Color& irradiance)
+      : towardsLight_(glm::normalize(towardsLight)), irradiance_(irradiance) {}
+  bool sample(const Vec3&, Vec2, LightSample& out) const override {
+    out.wi = towardsLight_;
+    out.dist = kInfinity;
+    out.Li = irradiance_;
+    out.pdf = 1.0f;
+    out.delta = true;
+    return true;
+  }
+  float pdf(const Vec3&, const Vec3&, const Vec3&) const override { return 0.0f; }
+  // Power through a disc of the scene's radius (PBRT4 section 12.4).
+  Color power(float sceneRadius) const override { return kPi * sceneRadius * sceneRadius * irradiance_; }
+  bool isDelta() const override { return true; }
+
+ private:
+  Vec3 towardsLight_;
+  Color irradiance_;
+};
+
 class AreaLight final : public Light {
  public:
   AreaLight(const Shape* shape, const Color& radiance) : shape_(shape), radiance_(radiance) {}
