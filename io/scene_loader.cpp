@@ -94,18 +94,21 @@ class JsonSceneLoader {
     scene_.background = n.color("background", Color(0.0f));
   }
 
+  // The optional "filter" key of a texture or environment map.
+  static TextureFilter readFilter(const JsonNode& n) {
+    const auto f = n.find("filter");
+    if (!f) return TextureFilter::Bilinear;
+    const std::string v = f->string();
+    if (v == "nearest") return TextureFilter::Nearest;
+    if (v != "bilinear") f->fail("unknown filter '" + v + "'; valid: nearest, bilinear");
+    return TextureFilter::Bilinear;
+  }
+
   void readEnvironment(const JsonNode& n) {
     n.allowKeys({"map", "scale", "rotate_y_deg", "filter"});
     if (!isBlack(scene_.background)) n.fail("give either render.background or environment, not both");
     const JsonNode file = n.at("map");
-    TextureFilter filter = TextureFilter::Bilinear;
-    if (auto f = n.find("filter")) {
-      const std::string v = f->string();
-      if (v == "nearest")
-        filter = TextureFilter::Nearest;
-      else if (v != "bilinear")
-        f->fail("unknown filter '" + v + "'; valid: nearest, bilinear");
-    }
+    const TextureFilter filter = readFilter(n);
     try {
       scene_.environmentMap =
           loadEnvironmentMap((baseDir_ / file.string()).string(), n.color("scale", Color(1.0f)), filter);
@@ -129,14 +132,7 @@ class JsonSceneLoader {
       else if (v != "auto")
         e->fail("unknown encoding '" + v + "'; valid: auto, srgb, linear");
     }
-    TextureFilter filter = TextureFilter::Bilinear;
-    if (auto f = n.find("filter")) {
-      const std::string v = f->string();
-      if (v == "nearest")
-        filter = TextureFilter::Nearest;
-      else if (v != "bilinear")
-        f->fail("unknown filter '" + v + "'; valid: nearest, bilinear");
-    }
+    const TextureFilter filter = readFilter(n);
     TextureWrap wrap = TextureWrap::Repeat;
     if (auto w = n.find("wrap")) {
       const std::string v = w->string();

@@ -4,17 +4,22 @@
 
 namespace ember {
 
-bool PointLight::sample(const Vec3& ref, Vec2, LightSample& out) const {
-  const Vec3 d = position_ - ref;
+// The delta-light sample towards `position`, with radiant intensity I arriving as I / d^2.
+static bool samplePosition(const Vec3& position, const Vec3& ref, const Color& intensity, LightSample& out) {
+  const Vec3 d = position - ref;
   const float dist2 = glm::dot(d, d);
   if (dist2 == 0.0f) return false;
   out.dist = std::sqrt(dist2);
   out.wi = d / out.dist;
-  out.p = position_;
-  out.Li = intensity_ / dist2;
+  out.p = position;
+  out.Li = intensity / dist2;
   out.pdf = 1.0f;
   out.delta = true;
   return true;
+}
+
+bool PointLight::sample(const Vec3& ref, Vec2, LightSample& out) const {
+  return samplePosition(position_, ref, intensity_, out);
 }
 
 SpotLight::SpotLight(const Vec3& position, const Vec3& direction, const Color& intensity, float innerRad,
@@ -33,15 +38,8 @@ float SpotLight::falloff(float cosAngle) const {
 }
 
 bool SpotLight::sample(const Vec3& ref, Vec2, LightSample& out) const {
-  const Vec3 d = position_ - ref;
-  const float dist2 = glm::dot(d, d);
-  if (dist2 == 0.0f) return false;
-  out.dist = std::sqrt(dist2);
-  out.wi = d / out.dist;
-  out.p = position_;
-  out.Li = intensity_ * (falloff(glm::dot(-out.wi, direction_)) / dist2);
-  out.pdf = 1.0f;
-  out.delta = true;
+  if (!samplePosition(position_, ref, intensity_, out)) return false;
+  out.Li *= falloff(glm::dot(-out.wi, direction_));
   return true;
 }
 
