@@ -47,6 +47,13 @@ Film renderFilm(const Scene& scene, int spp, uint64_t seed, RenderStats* stats =
   return film;
 }
 
+// A 10 x 10 quad at y = 0 facing +y: the receiving plane of the analytic lighting tests.
+std::unique_ptr<Shape> floorQuad() {
+  return std::make_unique<Quad>(
+      std::array<Vec3, 4>{Vec3(-5, 0, 5), Vec3(5, 0, 5), Vec3(5, 0, -5), Vec3(-5, 0, -5)},
+      std::array<Vec2, 4>{Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)});
+}
+
 Scene smallCornell() {
   Scene scene = loadJsonScene(test::sourcePath("scenes/cornell-area.json"));
   scene.settings.width = 40;
@@ -148,12 +155,7 @@ TEST(Render, PlaneUnderPointLightMatchesAnalyticIrradiance) {
   scene.settings.maxDepth = 2;
   scene.cameraParams = CameraParams{Vec3(0, 1, 0), Vec3(0, 0, 0), Vec3(0, 0, -1), 0.05f};
   const Material* m = scene.addMaterial("grey", std::make_unique<Lambertian>(grey(kAlbedo)));
-  scene.shapes.push_back(
-      {"floor",
-       std::make_unique<Quad>(
-           std::array<Vec3, 4>{Vec3(-5, 0, 5), Vec3(5, 0, 5), Vec3(5, 0, -5), Vec3(-5, 0, -5)},
-           std::array<Vec2, 4>{Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)}),
-       m, Color(0.0f)});
+  scene.shapes.push_back({"floor", floorQuad(), m, Color(0.0f)});
   scene.lights.push_back(std::make_unique<PointLight>(light, Color(kIntensity)));
   scene.build();
   const Image img = renderWith(scene, 64, 1, 5);
@@ -216,12 +218,7 @@ TEST(Render, PlaneOnTheAxisOfADiscLightMatchesTheViewFactor) {
   scene.cameraParams = CameraParams{Vec3(2.0f, 0.8f, 0.0f), Vec3(0.0f), Vec3(0, 1, 0), 0.02f};
   const Material* m = scene.addMaterial("grey", std::make_unique<Lambertian>(grey(kAlbedo)));
   const Material* black = scene.addMaterial("black", std::make_unique<Lambertian>(grey(0.0f)));
-  scene.shapes.push_back(
-      {"floor",
-       std::make_unique<Quad>(
-           std::array<Vec3, 4>{Vec3(-5, 0, 5), Vec3(5, 0, 5), Vec3(5, 0, -5), Vec3(-5, 0, -5)},
-           std::array<Vec2, 4>{Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)}),
-       m, Color(0.0f)});
+  scene.shapes.push_back({"floor", floorQuad(), m, Color(0.0f)});
   scene.shapes.push_back({"light", std::make_unique<Disc>(Vec3(0.0f, kHeight, 0.0f), Vec3(0, -1, 0), kRadius),
                           black, Color(kRadiance)});
   scene.build();
