@@ -1,6 +1,7 @@
 #include "accel/embree_accel.h"
 
 #include "accel/user_geometry.h"
+#include "renderer/rng.h"
 
 #include <cstdio>
 #include <cstring>
@@ -39,6 +40,29 @@ uint32_t EmbreeAccel::addShape(const Shape* shape) {
   return id;
 }
 
+// Alpha cut-outs and stochastic transparency (glTF alpha modes): Embree calls this for every
+// candidate hit of a mesh with an opacity, and a hit rejected here is skipped as if the surface were
+// not there, for closest-hit and shadow rays alike. The random number is a hash of the ray and the
+// triangle, so renders stay deterministic and independent of the thread count.
+static void meshOpacityFilter(const RTCFilterFunctionNArguments* args) {
+  const auto* mesh = static_cast<const TriangleMesh*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    const uint32_t prim = RTCHitN_primID(args->hit, args->N, i);
+    const Vec2 uv = mesh->uvAt(prim, RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i));
+    uint32_t bits[7];
+    const float ray[6] = {RTCRayN_org_x(args->ray, args->N, i), RTCRayN_org_y(args->ray, args->N, i),
+                          RTCRayN_org_z(args->ray, args->N, i), RTCRayN_dir_x(args->ray, args->N, i),
+                          RTCRayN_dir_y(args->ray, args->N, i), RTCRayN_dir_z(args->ray, args->N, i)};
+    std::memcpy(bits, ray, sizeof(ray));
+    bits[6] = prim;
+    uint64_t h = 0x9e3779b97f4a7c15ull;
+    for (uint32_t b : bits) h = mix64(h ^ b);
+    const float u = float(h >> 40) * 0x1p-24f;
+    if (mesh->opacity->passesThrough(uv, u)) args->valid[i] = 0;
+  }
+}
+
 uint32_t EmbreeAccel::addMesh(const TriangleMesh* mesh) {
   RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
   // Embree-owned buffers: Embree pads them as its SIMD loads need (16 bytes past the end).
@@ -48,6 +72,11 @@ uint32_t EmbreeAccel::addMesh(const TriangleMesh* mesh) {
   auto* indices = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
       geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), mesh->indices.size()));
   std::memcpy(indices, mesh->indices.data(), mesh->indices.size() * sizeof(glm::uvec3));
+  if (mesh->opacity) {
+    rtcSetGeometryUserData(geom, const_cast<TriangleMesh*>(mesh));
+    rtcSetGeometryIntersectFilterFunction(geom, meshOpacityFilter);
+    rtcSetGeometryOccludedFilterFunction(geom, meshOpacityFilter);
+  }
   rtcCommitGeometry(geom);
   const uint32_t id = rtcAttachGeometry(scene_, geom);
   rtcReleaseGeometry(geom);

@@ -17,8 +17,15 @@ TriangleMesh::Surface TriangleMesh::surfaceAt(uint32_t prim, float b1, float b2)
     // A degenerate interpolated normal (opposite vertex normals) falls back to flat shading.
     if (nl > 1e-6f && std::isfinite(nl)) s.ns = n / nl;
   }
-  s.uv = uvs.empty() ? Vec2(b1, b2) : b0 * uvs[idx.x] + b1 * uvs[idx.y] + b2 * uvs[idx.z];
+  s.uv = uvAt(prim, b1, b2);
+  if (!tangents.empty()) s.tangent = b0 * tangents[idx.x] + b1 * tangents[idx.y] + b2 * tangents[idx.z];
   return s;
+}
+
+Vec2 TriangleMesh::uvAt(uint32_t prim, float b1, float b2) const {
+  if (uvs.empty()) return Vec2(b1, b2);
+  const glm::uvec3& idx = indices[prim];
+  return (1.0f - b1 - b2) * uvs[idx.x] + b1 * uvs[idx.y] + b2 * uvs[idx.z];
 }
 
 float TriangleMesh::triangleArea(uint32_t prim) const {
@@ -31,6 +38,38 @@ Bounds TriangleMesh::bounds() const {
   Bounds b;
   for (const Vec3& p : positions) b.extend(p);
   return b;
+}
+
+void TriangleMesh::generateTangents() {
+  if (normals.empty() || uvs.empty()) return;
+  std::vector<Vec3> sumT(positions.size(), Vec3(0.0f)), sumB(positions.size(), Vec3(0.0f));
+  for (const glm::uvec3& idx : indices) {
+    const Vec3 dp1 = positions[idx.y] - positions[idx.x], dp2 = positions[idx.z] - positions[idx.x];
+    const Vec2 duv1 = uvs[idx.y] - uvs[idx.x], duv2 = uvs[idx.z] - uvs[idx.x];
+    const float det = duv1.x * duv2.y - duv2.x * duv1.y;
+    const float weight = 0.5f * glm::length(glm::cross(dp1, dp2));
+    if (!(std::abs(det) > 1e-20f) || !(weight > 0.0f)) continue;  // degenerate: no gradient
+    // Solving dp = dp/du du + dp/dv dv over both edges; weighting by |det| (UV area) is implicit
+    // in leaving the sums unnormalised, so large triangles count more, as in Lengyel's method.
+    const Vec3 dpdu = (dp1 * duv2.y - dp2 * duv1.y) / det;
+    const Vec3 dpdv = (dp2 * duv1.x - dp1 * duv2.x) / det;
+    for (uint32_t v : {idx.x, idx.y, idx.z}) {
+      sumT[v] += weight * glm::normalize(dpdu);
+      sumB[v] += weight * glm::normalize(dpdv);
+    }
+  }
+  tangents.assign(positions.size(), glm::vec4(0.0f));
+  for (size_t v = 0; v < positions.size(); ++v) {
+    const Vec3& n = normals[v];
+    Vec3 t = sumT[v] - n * glm::dot(n, sumT[v]);
+    if (!(glm::length(t) > 1e-12f)) {
+      const Frame frame(n);  // no usable UV gradient: any tangent keeps the frame valid
+      t = frame.s;
+    }
+    t = glm::normalize(t);
+    const float w = glm::dot(glm::cross(n, t), -sumB[v]) < 0.0f ? -1.0f : 1.0f;
+    tangents[v] = glm::vec4(t, w);
+  }
 }
 
 }  // namespace ember

@@ -1,31 +1,53 @@
 // An indexed triangle mesh in world space (from glTF), traced by Embree's own triangle kernels.
-// Normals and UVs are optional per-vertex attributes; without normals the mesh is shaded flat.
+// Normals, UVs and tangents are optional per-vertex attributes; without normals the mesh is shaded
+// flat. An optional opacity makes parts of it transparent to rays (glTF alpha modes).
 #pragma once
 
 #include "accel/shape.h"
 
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace ember {
 
+// Decides, inside Embree's traversal, whether a ray passes through the mesh at a hit.
+class MeshOpacity {
+ public:
+  virtual ~MeshOpacity() = default;
+  // `u` is uniform in [0, 1), a hash of the ray and the triangle, for stochastic transparency.
+  virtual bool passesThrough(Vec2 uv, float u) const = 0;
+};
+
 struct TriangleMesh {
   std::string name;
   std::vector<Vec3> positions;
-  std::vector<Vec3> normals;  // empty, or one per position
-  std::vector<Vec2> uvs;      // empty, or one per position
+  std::vector<Vec3> normals;        // empty, or one per position
+  std::vector<Vec2> uvs;            // empty, or one per position
+  std::vector<glm::vec4> tangents;  // empty, or one per position: xyz and the bitangent sign w
   std::vector<glm::uvec3> indices;
+  std::shared_ptr<const MeshOpacity> opacity;  // null: opaque
 
   struct Surface {
     Vec3 ng;  // front normal: normalize(cross(p1 - p0, p2 - p0))
     Vec3 ns;  // interpolated vertex normal, or ng
     Vec2 uv;
+    glm::vec4 tangent{0.0f};  // interpolated tangent and sign; zero when the mesh has none
   };
   // Surface attributes at barycentrics (b1, b2) of triangle `prim`.
   Surface surfaceAt(uint32_t prim, float b1, float b2) const;
+  Vec2 uvAt(uint32_t prim, float b1, float b2) const;
 
   float triangleArea(uint32_t prim) const;
   Bounds bounds() const;
+
+  // Per-vertex tangents for normal mapping when the file has none: the UV-gradient tangent of
+  // every triangle (Lengyel 2001) summed over the triangles sharing a vertex, made orthogonal to
+  // the vertex normal. The bitangent sign follows glTF's convention that a normal map's +Y points
+  // up in the image, i.e. towards decreasing v: w = sign(dot(cross(n, t), -dp/dv)). This agrees
+  // with MikkTSpace on meshes whose UV charts are not mirrored within a vertex's fan. Needs
+  // normals and UVs; does nothing without them.
+  void generateTangents();
 };
 
 }  // namespace ember

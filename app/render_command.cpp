@@ -26,6 +26,7 @@ struct RenderArgs {
   std::string png;
   std::string variance;
   std::optional<int> spp, threads, width, height, maxDepth;
+  int camera = -1;
   std::optional<uint64_t> seed;
   uint64_t firstSample = 0;
   std::string sampler;
@@ -78,7 +79,9 @@ int runRender(const RenderArgs& a) {
   if (!a.variance.empty()) checkOutputPath(a.variance, ".exr", "--variance");
 
   const auto loadStart = std::chrono::steady_clock::now();
-  Scene scene = loadScene(a.scene);
+  LoadOptions loadOptions;
+  loadOptions.camera = a.camera;
+  Scene scene = loadScene(a.scene, loadOptions);
   RenderSettings& s = scene.settings;
   if (a.spp) s.spp = *a.spp;
   if (a.seed) s.seed = *a.seed;
@@ -165,6 +168,10 @@ Runner addRenderCommand(CLI::App& app) {
   cmd->add_option("--env", args->env,
                   "Environment light: r,g,b (or one number) for a constant colour, or an equirectangular "
                   "EXR/HDR map; replaces the scene's");
+  cmd->add_option("--camera", args->camera,
+                  "glTF files: render through camera N of the file's `cameras` (default: the first one a "
+                  "node places, else a camera framing the scene)")
+      ->check(CLI::Range(0, 1 << 20));
   cmd->add_option("--variance", args->variance, "Also write the per-pixel variance of the mean as an EXR");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress display (the summary line is still printed)");
   return [args] { return runRender(*args); };

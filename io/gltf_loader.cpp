@@ -1,8 +1,7 @@
 #include "io/gltf_loader.h"
 
-#include "io/image_io.h"
+#include "io/gltf_materials.h"
 #include "io/input_error.h"
-#include "materials/lambertian.h"
 
 #include <tiny_gltf.h>
 #include <glm/gtc/matrix_transform.hpp>
@@ -22,11 +21,28 @@ constexpr int kModeTriangles = 4, kModeStrip = 5, kModeFan = 6;
 
 class GltfImporter {
  public:
-  GltfImporter(const std::string& path, Scene& scene, const Material* override)
-      : path_(path), scene_(scene), override_(override) {}
+  GltfImporter(const std::string& path, Scene& scene, const GltfImportOptions& options)
+      : path_(path), scene_(scene), options_(options), materials_(model_, path, scene) {}
 
-  GltfImport run(const Mat4& transform) {
+  GltfImport run() {
     load();
+    checkExtensions();
+    result_.cameraCount = model_.cameras.size();
+    if (options_.camera >= 0 && size_t(options_.camera) >= model_.cameras.size())
+      fail("cameras", "camera " + std::to_string(options_.camera) + " requested, but the file has " +
+                          std::to_string(model_.cameras.size()));
+    for (size_t i = 0; i < model_.materials.size(); ++i) {
+      result_.materialNames.push_back(model_.materials[i].name);
+      if (options_.materialsByName.count(model_.materials[i].name))
+        usedOverrides_.insert(model_.materials[i].name);
+    }
+    for (const auto& [name, material] : options_.materialsByName)
+      if (!usedOverrides_.count(name)) {
+        std::string known;
+        for (const auto& m : model_.materials) known += (known.empty() ? "" : ", ") + ("'" + m.name + "'");
+        fail("materials",
+             "no material named '" + name + "'; the file has: " + (known.empty() ? "none" : known));
+      }
     std::vector<int> roots;
     if (!model_.scenes.empty()) {
       int sceneIndex = model_.defaultScene;
@@ -40,7 +56,9 @@ class GltfImporter {
         if (!children.count(i)) roots.push_back(i);
     }
     std::vector<int> stack;
-    for (int root : roots) visit(root, transform, stack);
+    for (int root : roots) visit(root, options_.transform, stack);
+    if (options_.camera >= 0 && !result_.camera)
+      fail("cameras[" + std::to_string(options_.camera) + "]", "no node of the scene uses this camera");
     return result_;
   }
 
@@ -62,6 +80,25 @@ class GltfImporter {
       while (!err.empty() && (err.back() == '\n' || err.back() == '\r')) err.pop_back();
       throw InputError(path_ + ": cannot load glTF: " + (err.empty() ? "unknown error" : err));
     }
+  }
+
+  // Extensions we implement (docs/gltf.md); any other one used is named in one warning, and one
+  // the file requires is an error, since the file cannot be rendered correctly without it.
+  void checkExtensions() const {
+    static const std::set<std::string> supported = {
+        "KHR_lights_punctual",        "KHR_materials_emissive_strength",
+        "KHR_materials_transmission", "KHR_materials_ior",
+        "KHR_materials_volume",       "KHR_texture_transform",
+        "KHR_mesh_quantization"};
+    for (const std::string& ext : model_.extensionsRequired)
+      if (!supported.count(ext))
+        fail("extensionsRequired", "the file requires " + ext + ", which Ember does not support");
+    std::string ignored;
+    for (const std::string& ext : model_.extensionsUsed)
+      if (!supported.count(ext)) ignored += (ignored.empty() ? "" : ", ") + ext;
+    if (!ignored.empty())
+      std::fprintf(stderr, "ember: %s: ignoring unsupported glTF extensions: %s\n", path_.c_str(),
+                   ignored.c_str());
   }
 
   static Mat4 localMatrix(const tinygltf::Node& node) {
@@ -93,7 +130,8 @@ class GltfImporter {
     const Mat4 world = parent * localMatrix(node);
     for (int i = 0; i < 16; ++i)
       if (!std::isfinite(world[i / 4][i % 4])) fail(where, "non-finite transform");
-    if (node.camera >= 0 && !result_.camera) readCamera(node.camera, world);
+    if (node.camera >= 0 && !result_.camera && (options_.camera < 0 || node.camera == options_.camera))
+      readCamera(node.camera, world, where + ".camera");
     if (const auto ext = node.extensions.find("KHR_lights_punctual"); ext != node.extensions.end())
       readLight(ext->second, world, where + ".extensions.KHR_lights_punctual");
     if (node.mesh >= 0) {
@@ -108,25 +146,35 @@ class GltfImporter {
     stack.pop_back();
   }
 
-  void readCamera(int index, const Mat4& world) {
-    if (size_t(index) >= model_.cameras.size()) return;
+  void readCamera(int index, const Mat4& world, const std::string& where) {
+    if (size_t(index) >= model_.cameras.size()) fail(where, "camera index out of range");
     const tinygltf::Camera& cam = model_.cameras[size_t(index)];
-    if (cam.type != "perspective") {
-      std::fprintf(
-          stderr,
-          "ember: %s: camera %d is %s; only perspective cameras are used, framing the scene instead\n",
-          path_.c_str(), index, cam.type.c_str());
-      return;
-    }
     CameraParams c;
+    // A camera looks down its node's -z with +y up (glTF 2.0 section 3.10.1).
     c.origin = Vec3(world * glm::vec4(0, 0, 0, 1));
     const Vec3 forward = glm::normalize(Vec3(world * glm::vec4(0, 0, -1, 0)));
     c.target = c.origin + forward;
     c.up = glm::normalize(Vec3(world * glm::vec4(0, 1, 0, 0)));
-    c.fovYDeg = glm::degrees(float(cam.perspective.yfov));
-    if (!(c.fovYDeg > 0.0f && c.fovYDeg < 180.0f) || !isFinite(c.origin) || !isFinite(forward)) return;
+    float aspect = 0.0f;
+    if (cam.type == "perspective") {
+      c.fovYDeg = glm::degrees(float(cam.perspective.yfov));
+      if (!(c.fovYDeg > 0.0f && c.fovYDeg < 180.0f)) fail(where, "yfov must lie in (0, pi)");
+      aspect = float(cam.perspective.aspectRatio);
+    } else if (cam.type == "orthographic") {
+      c.projection = Projection::Orthographic;
+      c.orthoHalfHeight = float(cam.orthographic.ymag);
+      const float xmag = float(cam.orthographic.xmag);
+      if (!(c.orthoHalfHeight > 0.0f && xmag > 0.0f && std::isfinite(c.orthoHalfHeight) &&
+            std::isfinite(xmag)))
+        fail(where, "orthographic xmag and ymag must be > 0");
+      aspect = xmag / c.orthoHalfHeight;
+    } else {
+      fail(where, "unknown camera type '" + cam.type + "'; valid: perspective, orthographic");
+    }
+    if (!isFinite(c.origin) || !isFinite(forward) || !isFinite(c.up))
+      fail(where, "degenerate camera transform");
     result_.camera = c;
-    result_.cameraAspect = float(cam.perspective.aspectRatio);
+    result_.cameraAspect = std::isfinite(aspect) && aspect > 0.0f ? aspect : 0.0f;
   }
 
   // KHR_lights_punctual, photometric to radiometric with 683 lm/W (docs/gltf.md): point and spot
@@ -168,6 +216,8 @@ class GltfImporter {
     const int components = tinygltf::GetNumComponentsInType(uint32_t(acc.type));
     count = acc.count;
     std::vector<float> out(count * size_t(components), 0.0f);
+    // Integer components are normalised when the accessor says so (always for TEXCOORD and COLOR
+    // in core glTF; KHR_mesh_quantization allows the rest): unsigned c / max, signed max(c / max, -1).
     forEachElement(acc, where, [&](const uint8_t* src, size_t i) {
       for (int c = 0; c < components; ++c) {
         float v;
@@ -176,12 +226,23 @@ class GltfImporter {
             std::memcpy(&v, src + 4 * c, 4);
             break;
           case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
-            v = src[c] / 255.0f;
+            v = acc.normalized ? src[c] / 255.0f : float(src[c]);
             break;
+          case TINYGLTF_COMPONENT_TYPE_BYTE: {
+            const auto b = static_cast<int8_t>(src[c]);
+            v = acc.normalized ? std::max(b / 127.0f, -1.0f) : float(b);
+            break;
+          }
           case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
             uint16_t s;
             std::memcpy(&s, src + 2 * c, 2);
-            v = s / 65535.0f;
+            v = acc.normalized ? s / 65535.0f : float(s);
+            break;
+          }
+          case TINYGLTF_COMPONENT_TYPE_SHORT: {
+            int16_t s;
+            std::memcpy(&s, src + 2 * c, 2);
+            v = acc.normalized ? std::max(s / 32767.0f, -1.0f) : float(s);
             break;
           }
           default:
@@ -292,6 +353,21 @@ class GltfImporter {
       mesh->uvs.resize(n);
       for (size_t i = 0; i < n; ++i) mesh->uvs[i] = Vec2(uvs[2 * i], uvs[2 * i + 1]);
     }
+    if (const auto tan = prim.attributes.find("TANGENT");
+        tan != prim.attributes.end() && !mesh->normals.empty()) {
+      size_t n = 0;
+      const std::vector<float> tangents =
+          readFloats(tan->second, TINYGLTF_TYPE_VEC4, where + ".attributes.TANGENT", n);
+      if (n != vertexCount) fail(where + ".attributes.TANGENT", "count differs from POSITION");
+      mesh->tangents.resize(n);
+      const glm::mat3 linear(world);  // tangents are directions on the surface: transformed like edges
+      for (size_t i = 0; i < n; ++i) {
+        const Vec3 t = linear * Vec3(tangents[4 * i], tangents[4 * i + 1], tangents[4 * i + 2]);
+        // A mirroring transform flips the handedness of the (T, B, N) frame.
+        const float det = glm::determinant(linear);
+        mesh->tangents[i] = glm::vec4(t, tangents[4 * i + 3] * (det < 0.0f ? -1.0f : 1.0f));
+      }
+    }
 
     std::vector<uint32_t> order;
     if (prim.indices >= 0) {
@@ -309,9 +385,16 @@ class GltfImporter {
 
     result_.triangles += mesh->indices.size();
     ++result_.primitives;
-    Color emission(0.0f);
-    const Material* material = override_ ? override_ : materialFor(prim.material, emission);
-    scene_.meshes.push_back({std::move(mesh), material, emission});
+    const GltfSurface& surface = materials_.surface(prim.material);
+    const Material* material = surface.material;
+    if (options_.materialOverride) {
+      material = options_.materialOverride;
+    } else if (prim.material >= 0 && size_t(prim.material) < model_.materials.size()) {
+      const auto it = options_.materialsByName.find(model_.materials[size_t(prim.material)].name);
+      if (it != options_.materialsByName.end()) material = it->second;
+    }
+    mesh->opacity = surface.opacity;
+    scene_.meshes.push_back({std::move(mesh), material, surface.emission, surface.maps});
   }
 
   static void appendTriangles(TriangleMesh& mesh, const std::vector<uint32_t>& order, int mode) {
@@ -329,75 +412,19 @@ class GltfImporter {
     }
   }
 
-  const Material* materialFor(int index, Color& emission) {
-    if (index < 0 || size_t(index) >= model_.materials.size()) {
-      if (!defaultMaterial_)
-        defaultMaterial_ = scene_.addMaterial(
-            "(glTF default)", std::make_unique<Lambertian>(std::make_shared<ConstantTexture>(Color(0.8f))));
-      return defaultMaterial_;
-    }
-    const tinygltf::Material& m = model_.materials[size_t(index)];
-    if (m.emissiveFactor.size() == 3)
-      emission = Color(float(m.emissiveFactor[0]), float(m.emissiveFactor[1]), float(m.emissiveFactor[2]));
-    if (!isFinite(emission)) emission = Color(0.0f);
-    if (const auto it = materials_.find(index); it != materials_.end()) return it->second;
-
-    const auto& pbr = m.pbrMetallicRoughness;
-    Color factor(1.0f);
-    if (pbr.baseColorFactor.size() >= 3)
-      factor = glm::clamp(
-          Color(float(pbr.baseColorFactor[0]), float(pbr.baseColorFactor[1]), float(pbr.baseColorFactor[2])),
-          Color(0.0f), Color(1.0f));
-    std::shared_ptr<const Texture> albedo = baseColorTexture(pbr.baseColorTexture.index, factor, index);
-    if (!albedo) albedo = std::make_shared<ConstantTexture>(factor);
-    const std::string name = m.name.empty() ? "material" + std::to_string(index) : m.name;
-    return materials_[index] = scene_.addMaterial(name, std::make_unique<Lambertian>(std::move(albedo)));
-  }
-
-  std::shared_ptr<const Texture> baseColorTexture(int textureIndex, const Color& factor, int materialIndex) {
-    if (textureIndex < 0) return nullptr;
-    const std::string where = "materials[" + std::to_string(materialIndex) + "].baseColorTexture";
-    if (size_t(textureIndex) >= model_.textures.size()) fail(where, "texture index out of range");
-    const tinygltf::Texture& tex = model_.textures[size_t(textureIndex)];
-    if (tex.source < 0 || size_t(tex.source) >= model_.images.size()) fail(where, "image index out of range");
-    const tinygltf::Image& img = model_.images[size_t(tex.source)];
-    if (img.width <= 0 || img.height <= 0 || img.image.empty() || img.bits != 8) {
-      std::fprintf(stderr,
-                   "ember: %s: %s: image could not be used (need 8-bit pixels); using baseColorFactor\n",
-                   path_.c_str(), where.c_str());
-      return nullptr;
-    }
-    const size_t expected = size_t(img.width) * size_t(img.height) * size_t(img.component);
-    if (img.component < 1 || img.image.size() < expected)
-      fail(where, "decoded image is smaller than its size says");
-    TextureImage decoded =
-        textureFromBytes(img.image.data(), img.width, img.height, img.component, /*srgb=*/true);
-    TextureWrap wrap = TextureWrap::Repeat;
-    TextureFilter filter = TextureFilter::Bilinear;
-    if (tex.sampler >= 0 && size_t(tex.sampler) < model_.samplers.size()) {
-      const tinygltf::Sampler& s = model_.samplers[size_t(tex.sampler)];
-      if (s.wrapS == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE) wrap = TextureWrap::Clamp;
-      if (s.wrapS == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT) wrap = TextureWrap::Mirror;
-      if (s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST) filter = TextureFilter::Nearest;
-    }
-    return std::make_shared<ImageTexture>(decoded.width, decoded.height, std::move(decoded.texels), filter,
-                                          wrap, factor);
-  }
-
   std::string path_;
   Scene& scene_;
-  const Material* override_;
+  GltfImportOptions options_;
   tinygltf::Model model_;
+  GltfMaterialReader materials_;
   GltfImport result_;
-  std::map<int, const Material*> materials_;
-  const Material* defaultMaterial_ = nullptr;
+  std::set<std::string> usedOverrides_;
 };
 
 }  // namespace
 
-GltfImport importGltf(const std::string& path, Scene& scene, const Mat4& transform,
-                      const Material* materialOverride) {
-  return GltfImporter(path, scene, materialOverride).run(transform);
+GltfImport importGltf(const std::string& path, Scene& scene, const GltfImportOptions& options) {
+  return GltfImporter(path, scene, options).run();
 }
 
 }  // namespace ember

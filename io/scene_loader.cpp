@@ -59,10 +59,18 @@ class JsonSceneLoader {
   }
 
   void readCamera(const JsonNode& n) {
-    n.allowKeys({"type", "origin", "target", "up", "fov_y_deg"});
-    if (n.has("type") && n.at("type").string() != "pinhole")
-      n.at("type").fail("unknown camera type; valid types are: pinhole");
+    n.allowKeys({"type", "origin", "target", "up", "fov_y_deg", "half_height"});
+    const std::string type = n.has("type") ? n.at("type").string() : "pinhole";
+    if (type != "pinhole" && type != "orthographic")
+      n.at("type").fail("unknown camera type; valid types are: pinhole, orthographic");
     CameraParams& c = scene_.cameraParams;
+    if (type == "orthographic") {
+      c.projection = Projection::Orthographic;
+      c.orthoHalfHeight = n.at("half_height").positive();
+      if (n.has("fov_y_deg")) n.at("fov_y_deg").fail("not used by an orthographic camera");
+    } else if (n.has("half_height")) {
+      n.at("half_height").fail("only used by an orthographic camera");
+    }
     c.origin = n.at("origin").vec3();
     c.target = n.at("target").vec3();
     c.up = n.has("up") ? n.at("up").direction() : Vec3(0.0f, 1.0f, 0.0f);
@@ -220,7 +228,10 @@ class JsonSceneLoader {
       if (emissive) return blackMaterial();
       s.at("material");  // reports it as missing
     }
-    const JsonNode m = s.at("material");
+    return materialNamed(s.at("material"));
+  }
+
+  const Material* materialNamed(const JsonNode& m) {
     const std::string name = m.string();
     const auto it = materials_.find(name);
     if (it == materials_.end()) {
@@ -300,7 +311,7 @@ class JsonSceneLoader {
         s.at("vertices").fail("the four vertices of a quad must lie in one plane");
       shape = std::make_unique<Quad>(v, uv);
     } else if (type == "mesh") {
-      common({"file", "transform"});
+      common({"file", "transform", "materials"});
       if (s.has("flip_normals")) s.at("flip_normals").fail("not supported for meshes");
       readMesh(s, emission);
       return;
@@ -371,11 +382,19 @@ class JsonSceneLoader {
   void readMesh(const JsonNode& s, const Color& emission) {
     const JsonNode file = s.at("file");
     const fs::path meshPath = baseDir_ / file.string();
-    const Mat4 transform = s.has("transform") ? readTransform(s.at("transform")) : Mat4(1.0f);
-    const Material* override = s.has("material") ? materialFor(s, false) : nullptr;
+    GltfImportOptions options;
+    options.transform = s.has("transform") ? readTransform(s.at("transform")) : Mat4(1.0f);
+    options.materialOverride = s.has("material") ? materialFor(s, false) : nullptr;
+    if (auto byName = s.find("materials")) {
+      // {"glTF material name": "Ember material name", ...}
+      if (options.materialOverride) byName->fail("'material' and 'materials' cannot be combined");
+      byName->requireObject();
+      for (auto it = byName->raw().begin(); it != byName->raw().end(); ++it)
+        options.materialsByName[it.key()] = materialNamed(byName->at(it.key()));
+    }
     const size_t first = scene_.meshes.size();
     try {
-      importGltf(meshPath.string(), scene_, transform, override);
+      importGltf(meshPath.string(), scene_, options);
     } catch (const InputError& e) {
       file.fail(e.what());
     }
@@ -439,10 +458,12 @@ CameraParams framingCamera(const Bounds& b, float aspect) {
   return c;
 }
 
-Scene loadGltfScene(const std::string& path) {
+Scene loadGltfScene(const std::string& path, const LoadOptions& load) {
   Scene scene;
   scene.sourcePath = path;
-  const GltfImport imported = importGltf(path, scene);
+  GltfImportOptions options;
+  options.camera = load.camera;
+  const GltfImport imported = importGltf(path, scene, options);
   if (imported.triangles == 0) throw InputError(path + ": the scene contains no triangles to render");
   Bounds bounds;
   for (const auto& m : scene.meshes) bounds.extend(m.mesh->bounds());
@@ -471,10 +492,12 @@ Scene loadJsonScene(const std::string& path) {
   return scene;
 }
 
-Scene loadScene(const std::string& path) {
+Scene loadScene(const std::string& path, const LoadOptions& options) {
   if (!fs::exists(path)) throw InputError(path + ": no such file");
   if (fs::is_directory(path)) throw InputError(path + ": is a directory, not a scene file");
-  return isGltfPath(path) ? loadGltfScene(path) : loadJsonScene(path);
+  if (!isGltfPath(path) && options.camera >= 0)
+    throw InputError(path + ": --camera selects a camera of a glTF file; a JSON scene has one camera");
+  return isGltfPath(path) ? loadGltfScene(path, options) : loadJsonScene(path);
 }
 
 }  // namespace ember

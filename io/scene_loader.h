@@ -9,7 +9,11 @@
 
 namespace ember {
 
-Scene loadScene(const std::string& path);
+struct LoadOptions {
+  int camera = -1;  // glTF files: index into the file's cameras (-1: the first one placed by a node)
+};
+
+Scene loadScene(const std::string& path, const LoadOptions& options = {});
 Scene loadJsonScene(const std::string& path);
 
 bool isGltfPath(const std::string& path);

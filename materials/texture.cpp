@@ -3,12 +3,13 @@
 namespace ember {
 
 ImageTexture::ImageTexture(int width, int height, std::vector<Color> texels, TextureFilter filter,
-                           TextureWrap wrap, const Color& scale)
+                           TextureWrap wrapS, TextureWrap wrapT, const Color& scale)
     : width_(width),
       height_(height),
       texels_(std::move(texels)),
       filter_(filter),
-      wrap_(wrap),
+      wrapS_(wrapS),
+      wrapT_(wrapT),
       scale_(scale) {
   Color sum(0.0f);
   for (const Color& c : texels_) {
@@ -34,8 +35,8 @@ static int wrapIndex(int i, int n, TextureWrap wrap) {
 }
 
 Color ImageTexture::texel(int x, int y) const {
-  x = wrapIndex(x, width_, wrap_);
-  y = wrapIndex(y, height_, wrap_);
+  x = wrapIndex(x, width_, wrapS_);
+  y = wrapIndex(y, height_, wrapT_);
   return texels_[size_t(y) * size_t(width_) + size_t(x)];
 }
 

@@ -38,7 +38,11 @@ enum class TextureWrap { Clamp, Repeat, Mirror };
 class ImageTexture final : public Texture {
  public:
   ImageTexture(int width, int height, std::vector<Color> texels, TextureFilter filter, TextureWrap wrap,
-               const Color& scale = Color(1.0f));
+               const Color& scale = Color(1.0f))
+      : ImageTexture(width, height, std::move(texels), filter, wrap, wrap, scale) {}
+  // wrapS applies along u (columns), wrapT along v (rows), as glTF samplers define them.
+  ImageTexture(int width, int height, std::vector<Color> texels, TextureFilter filter, TextureWrap wrapS,
+               TextureWrap wrapT, const Color& scale = Color(1.0f));
   Color eval(Vec2 uv) const override;
   Color maxValue() const override { return max_; }
   Color average() const override { return average_; }
@@ -51,9 +55,29 @@ class ImageTexture final : public Texture {
   int width_, height_;
   std::vector<Color> texels_;
   TextureFilter filter_;
-  TextureWrap wrap_;
+  TextureWrap wrapS_, wrapT_;
   Color scale_;
   Color max_{0.0f}, average_{0.0f};
+};
+
+// KHR_texture_transform: looks `inner` up at uv' = T R S uv (the extension's matrix: offset, then a
+// rotation by `rotation` radians counter-clockwise in UV space, then scale).
+class UvTransformTexture final : public Texture {
+ public:
+  UvTransformTexture(std::shared_ptr<const Texture> inner, Vec2 offset, float rotation, Vec2 scale)
+      : inner_(std::move(inner)),
+        offset_(offset),
+        row0_(std::cos(rotation) * scale.x, std::sin(rotation) * scale.y),
+        row1_(-std::sin(rotation) * scale.x, std::cos(rotation) * scale.y) {}
+  Color eval(Vec2 uv) const override {
+    return inner_->eval(Vec2(glm::dot(row0_, uv), glm::dot(row1_, uv)) + offset_);
+  }
+  Color maxValue() const override { return inner_->maxValue(); }
+  Color average() const override { return inner_->average(); }
+
+ private:
+  std::shared_ptr<const Texture> inner_;
+  Vec2 offset_, row0_, row1_;
 };
 
 // The exact piecewise sRGB EOTF (IEC 61966-2-1) for one channel value in [0, 1].

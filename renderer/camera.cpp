@@ -2,15 +2,17 @@
 
 namespace ember {
 
-PinholeCamera::PinholeCamera(const CameraParams& params, int width, int height)
+Camera::Camera(const CameraParams& params, int width, int height)
     : params_(params),
       origin_(params.origin),
       forward_(glm::normalize(params.target - params.origin)),
       right_(glm::normalize(glm::cross(forward_, params.up))),
       up_(glm::cross(right_, forward_)),
-      tanHalf_(std::tan(glm::radians(params.fovYDeg) * 0.5f)),
+      scale_(params.projection == Projection::Orthographic ? params.orthoHalfHeight
+                                                           : std::tan(glm::radians(params.fovYDeg) * 0.5f)),
       aspect_(float(width) / float(height)),
       invWidth_(1.0f / float(width)),
-      invHeight_(1.0f / float(height)) {}
+      invHeight_(1.0f / float(height)),
+      orthographic_(params.projection == Projection::Orthographic) {}
 
 }  // namespace ember

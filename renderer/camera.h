@@ -1,28 +1,35 @@
-// Pinhole camera exactly as ../shared/refs/CONVENTIONS.md defines it: f = normalize(target -
+// The camera exactly as ../shared/refs/CONVENTIONS.md defines the pinhole: f = normalize(target -
 // origin), r = normalize(cross(f, up)), u = cross(r, f); raster (x, y) in [0,W]x[0,H] with y down;
 // direction = normalize(f + (2x/W - 1) t (W/H) r + (1 - 2y/H) t u), t = tan(vertical fov / 2).
+// The orthographic projection (glTF 2.0 section 3.10.3) uses the same frame: every ray points
+// along f and starts at origin + (2x/W - 1) ymag (W/H) r + (1 - 2y/H) ymag u.
 #pragma once
 
 #include "renderer/math.h"
 
 namespace ember {
 
+enum class Projection { Perspective, Orthographic };
+
 struct CameraParams {
   Vec3 origin{0.0f, 0.0f, 1.0f};
   Vec3 target{0.0f};
   Vec3 up{0.0f, 1.0f, 0.0f};
-  float fovYDeg = 40.0f;
+  float fovYDeg = 40.0f;  // perspective only
+  Projection projection = Projection::Perspective;
+  float orthoHalfHeight = 1.0f;  // orthographic only: glTF ymag, half the view's height in metres
 };
 
-class PinholeCamera {
+class Camera {
  public:
-  PinholeCamera() : PinholeCamera(CameraParams{}, 1, 1) {}
-  PinholeCamera(const CameraParams& params, int width, int height);
+  Camera() : Camera(CameraParams{}, 1, 1) {}
+  Camera(const CameraParams& params, int width, int height);
 
   // Ray through raster position (x, y); (0, 0) is the top-left corner of the image.
   Ray generateRay(float x, float y) const {
-    const float sx = (2.0f * x * invWidth_ - 1.0f) * tanHalf_ * aspect_;
-    const float sy = (1.0f - 2.0f * y * invHeight_) * tanHalf_;
+    const float sx = (2.0f * x * invWidth_ - 1.0f) * scale_ * aspect_;
+    const float sy = (1.0f - 2.0f * y * invHeight_) * scale_;
+    if (orthographic_) return Ray{origin_ + sx * right_ + sy * up_, forward_};
     return Ray{origin_, glm::normalize(forward_ + sx * right_ + sy * up_)};
   }
   const CameraParams& params() const { return params_; }
@@ -30,7 +37,8 @@ class PinholeCamera {
  private:
   CameraParams params_;
   Vec3 origin_, forward_, right_, up_;
-  float tanHalf_, aspect_, invWidth_, invHeight_;
+  float scale_, aspect_, invWidth_, invHeight_;  // scale_: tan(fov / 2), or ymag
+  bool orthographic_;
 };
 
 }  // namespace ember

@@ -73,6 +73,7 @@ bool TriangleLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
   out.pdf = pdf(ref, p, surface.ng);
   out.delta = false;
   out.Li = glm::dot(-out.wi, surface.ng) > 0.0f ? radiance_ : Color(0.0f);
+  if (texture_) out.Li *= texture_->eval(surface.uv);
   return out.pdf > 0.0f && std::isfinite(out.pdf);
 }
 

@@ -110,18 +110,25 @@ class AreaLight final : public Light {
 
 class TriangleLight final : public Light {
  public:
-  TriangleLight(const TriangleMesh* mesh, uint32_t prim, const Color& radiance)
-      : mesh_(mesh), prim_(prim), radiance_(radiance) {}
+  // `texture` (optional, borrowed) multiplies the radiance at the surface's UV (glTF emissiveTexture).
+  TriangleLight(const TriangleMesh* mesh, uint32_t prim, const Color& radiance,
+                const Texture* texture = nullptr)
+      : mesh_(mesh), prim_(prim), radiance_(radiance), texture_(texture) {}
   bool sample(const Vec3& ref, Vec2 u, LightSample& out) const override;
   float pdf(const Vec3& ref, const Vec3& p, const Vec3& n) const override {
     return areaToSolidAnglePdf(1.0f / mesh_->triangleArea(prim_), ref, p, n);
   }
-  Color power(float) const override { return kPi * mesh_->triangleArea(prim_) * radiance_; }
+  // With a texture, its mean over the whole image stands in for the mean over this triangle: power
+  // only steers which light is sampled, so an estimate costs variance, never bias.
+  Color power(float) const override {
+    return kPi * mesh_->triangleArea(prim_) * radiance_ * (texture_ ? texture_->average() : Color(1.0f));
+  }
 
  private:
   const TriangleMesh* mesh_;
   uint32_t prim_;
   Color radiance_;
+  const Texture* texture_;
 };
 
 // Radiance arriving from infinitely far away: a constant colour, or an equirectangular map

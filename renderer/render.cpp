@@ -29,7 +29,7 @@ RenderStats render(const Scene& scene, const Integrator& integrator, const Rende
   std::mutex statsMutex;
   std::atomic<uint64_t> nonFinite{0};
   ProgressReporter progress(uint64_t(width) * uint64_t(height), uint64_t(options.spp), options.progress);
-  const PinholeCamera& camera = scene.camera();
+  const Camera& camera = scene.camera();
 
   const auto start = std::chrono::steady_clock::now();
   tbb::task_arena arena(threads);

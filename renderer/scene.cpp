@@ -34,12 +34,14 @@ void Scene::build() {
     if (entry.mesh->indices.empty()) continue;
     const uint32_t id = accel_->addMesh(entry.mesh.get());
     if (records_.size() <= id) records_.resize(id + 1);
-    GeometryRecord rec{nullptr, entry.mesh.get(), entry.material, nullptr, entry.emission};
+    GeometryRecord rec{nullptr, entry.mesh.get(), entry.material, nullptr, entry.emission, entry.maps.get()};
+    if (entry.maps && entry.maps->normalMap && entry.mesh->tangents.empty()) entry.mesh->generateTangents();
     if (!isBlack(entry.emission)) {
       // Every triangle of an emissive mesh is a light of its own, chosen by power like the rest.
       rec.firstTriangleLight = int64_t(triangleLights_.size());
       for (uint32_t prim = 0; prim < entry.mesh->indices.size(); ++prim) {
-        lights.push_back(std::make_unique<TriangleLight>(entry.mesh.get(), prim, entry.emission));
+        lights.push_back(std::make_unique<TriangleLight>(entry.mesh.get(), prim, entry.emission,
+                                                         entry.maps ? entry.maps->emission.get() : nullptr));
         allLights.push_back(lights.back().get());
         triangleLights_.push_back(lights.back().get());
       }
@@ -63,7 +65,7 @@ void Scene::build() {
   }
   const float radius = 0.5f * glm::length(bounds_.upper - bounds_.lower);
   lightSampler_ = LightSampler(allLights, radius);
-  camera_ = PinholeCamera(cameraParams, settings.width, settings.height);
+  camera_ = Camera(cameraParams, settings.width, settings.height);
 }
 
 bool Scene::intersect(const Ray& ray, SurfaceHit& hit) const {
@@ -81,13 +83,17 @@ bool Scene::intersect(const Ray& ray, SurfaceHit& hit) const {
     const TriangleMesh::Surface s = rec.mesh->surfaceAt(raw.primID, raw.uv.x, raw.uv.y);
     hit.ng = s.ng;
     hit.uv = s.uv;
+    Vec3 ns = s.ns;
+    if (rec.maps && rec.maps->normalMap) ns = rec.maps->perturb(s.ns, s.tangent, s.uv);
     // Keep the shading normal in the geometric normal's hemisphere.
-    hit.ns = glm::dot(s.ns, s.ng) < 0.0f ? -s.ns : s.ns;
+    hit.ns = glm::dot(ns, s.ng) < 0.0f ? -ns : ns;
   }
   hit.material = rec.material;
   hit.light =
       rec.firstTriangleLight >= 0 ? triangleLights_[size_t(rec.firstTriangleLight) + raw.primID] : rec.light;
   hit.emission = rec.emission;
+  if (rec.maps && rec.maps->emission && !isBlack(rec.emission))
+    hit.emission *= rec.maps->emission->eval(hit.uv);
   return true;
 }
 

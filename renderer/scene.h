@@ -4,6 +4,7 @@
 
 #include "accel/embree_accel.h"
 #include "materials/material.h"
+#include "materials/surface_maps.h"
 #include "renderer/camera.h"
 #include "renderer/light.h"
 #include "renderer/light_sampler.h"
@@ -39,6 +40,7 @@ class Scene {
     std::unique_ptr<TriangleMesh> mesh;
     const Material* material = nullptr;
     Color emission{0.0f};
+    std::shared_ptr<const SurfaceMaps> maps;  // normal map, emissive texture; null = none
   };
 
   // --- filled in by a loader --------------------------------------------------------------
@@ -65,7 +67,7 @@ class Scene {
   // True when something blocks the segment from `from` (already offset) to `to`.
   bool occluded(const Vec3& from, const Vec3& dir, float dist) const;
 
-  const PinholeCamera& camera() const { return camera_; }
+  const Camera& camera() const { return camera_; }
   const LightSampler& lightSampler() const { return lightSampler_; }
   const EnvironmentLight* environment() const { return environment_; }
   Bounds bounds() const { return bounds_; }
@@ -79,6 +81,7 @@ class Scene {
     const Material* material = nullptr;
     const Light* light = nullptr;
     Color emission{0.0f};
+    const SurfaceMaps* maps = nullptr;
     int64_t firstTriangleLight = -1;  // emissive meshes: index of primitive 0's light in triangleLights_
   };
 
@@ -86,7 +89,7 @@ class Scene {
   std::vector<const Light*> triangleLights_;
   size_t loadedLightCount_ = 0;
   std::vector<GeometryRecord> records_;  // indexed by Embree geomID
-  PinholeCamera camera_;
+  Camera camera_;
   LightSampler lightSampler_;
   const EnvironmentLight* environment_ = nullptr;
   Bounds bounds_;

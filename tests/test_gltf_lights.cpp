@@ -49,6 +49,7 @@ std::string writeGltf(const TempDir& dir, const tinygltf::Light& light,
   ai.count = 6;
   m.accessors = {ap, ai};
   tinygltf::Material mat;
+  mat.name = "plane";  // replaced by an Ember Lambertian of albedo kAlbedo in the scene
   mat.pbrMetallicRoughness.baseColorFactor = {kAlbedo, kAlbedo, kAlbedo, 1.0};
   m.materials.push_back(mat);
   tinygltf::Primitive prim;
@@ -87,8 +88,10 @@ float renderAt(const TempDir& dir, const std::string& gltf, const Vec3& target) 
                            R"(], "target": [)" + std::to_string(target.x) + ", 0, " +
                            std::to_string(target.z) + R"(], "up": [0, 0, -1], "fov_y_deg": 0.05},
     "render": {"max_depth": 2, "sampler": "independent"},
+    "materials": {"grey": {"type": "diffuse", "reflectance": )" +
+                           std::to_string(kAlbedo) + R"(}},
     "shapes": [{"type": "mesh", "file": ")" +
-                           gltf + R"("}]})";
+                           gltf + R"(", "materials": {"plane": "grey"}}]})";
   Scene scene = loadScene(dir.write("s.json", json));
   scene.build();
   const PathIntegrator integrator(2, 5);

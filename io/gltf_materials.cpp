@@ -1,0 +1,276 @@
+#include "io/gltf_materials.h"
+
+#include "io/input_error.h"
+#include "materials/gltf_pbr.h"
+
+#include <cstdio>
+#include <cstring>
+
+namespace ember {
+
+namespace {
+
+float numberOr(const tinygltf::Value& object, const char* key, float fallback) {
+  if (!object.IsObject() || !object.Has(key)) return fallback;
+  const tinygltf::Value& v = object.Get(key);
+  return v.IsNumber() ? float(v.GetNumberAsDouble()) : std::numeric_limits<float>::quiet_NaN();
+}
+
+const tinygltf::Value* extension(const tinygltf::ExtensionMap& extensions, const char* name) {
+  const auto it = extensions.find(name);
+  return it == extensions.end() ? nullptr : &it->second;
+}
+
+// Extension objects nested inside an extension (a transmissionTexture's KHR_texture_transform)
+// reach us as plain JSON values rather than tinygltf's parsed ExtensionMap.
+tinygltf::ExtensionMap extensionsOf(const tinygltf::Value& info) {
+  tinygltf::ExtensionMap out;
+  const tinygltf::Value& ext = info.Get("extensions");
+  for (const std::string& key : ext.Keys()) out[key] = ext.Get(key);
+  return out;
+}
+
+TextureWrap wrapMode(int glMode) {
+  if (glMode == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE) return TextureWrap::Clamp;
+  if (glMode == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT) return TextureWrap::Mirror;
+  return TextureWrap::Repeat;  // the spec's default
+}
+
+}  // namespace
+
+void GltfMaterialReader::fail(const std::string& where, const std::string& what) const {
+  throw InputError(path_ + ": " + where + ": " + what);
+}
+
+void GltfMaterialReader::warn(const std::string& where, const std::string& what) const {
+  std::fprintf(stderr, "ember: %s: %s: %s\n", path_.c_str(), where.c_str(), what.c_str());
+}
+
+const GltfSurface& GltfMaterialReader::surface(int index) {
+  if (index < 0 || size_t(index) >= model_.materials.size()) index = -1;
+  if (const auto it = surfaces_.find(index); it != surfaces_.end()) return it->second;
+  return surfaces_[index] = convert(index);
+}
+
+GltfSurface GltfMaterialReader::convert(int index) {
+  GltfSurface out;
+  if (index < 0) {
+    // The specification's default material (section 3.9.6): every property at its default, i.e.
+    // a white, fully rough metal.
+    GltfPbrInputs in;
+    in.baseColor = std::make_shared<ConstantTexture>(Color(1.0f));
+    in.metallicRoughness = std::make_shared<ConstantTexture>(Color(0.0f, 1.0f, 1.0f));
+    out.material = scene_.addMaterial("(glTF default)", std::make_unique<GltfPbrMaterial>(std::move(in)));
+    return out;
+  }
+  const tinygltf::Material& m = model_.materials[size_t(index)];
+  const std::string where = "materials[" + std::to_string(index) + "]";
+  const auto& pbr = m.pbrMetallicRoughness;
+
+  glm::vec4 baseFactor(1.0f);
+  if (!pbr.baseColorFactor.empty()) {
+    if (pbr.baseColorFactor.size() != 4) fail(where + ".baseColorFactor", "expected 4 numbers");
+    for (int c = 0; c < 4; ++c) baseFactor[c] = float(pbr.baseColorFactor[size_t(c)]);
+  }
+  const float metallic = float(pbr.metallicFactor), roughness = float(pbr.roughnessFactor);
+  for (float v : {baseFactor.x, baseFactor.y, baseFactor.z, baseFactor.w, metallic, roughness})
+    if (!std::isfinite(v)) fail(where, "non-finite factor");
+  // Factors outside [0, 1] are invalid; exporters round to 1.0000001, so clamp rather than refuse.
+  baseFactor = glm::clamp(baseFactor, glm::vec4(0.0f), glm::vec4(1.0f));
+
+  GltfPbrInputs in;
+  const Color baseRgb(baseFactor);
+  in.baseColor = texture(pbr.baseColorTexture, Channels::SrgbRgb, baseRgb, where + ".baseColorTexture");
+  if (!in.baseColor) in.baseColor = std::make_shared<ConstantTexture>(baseRgb);
+  const Color mr(0.0f, std::clamp(roughness, 0.0f, 1.0f), std::clamp(metallic, 0.0f, 1.0f));
+  in.metallicRoughness = texture(pbr.metallicRoughnessTexture, Channels::MetallicRoughness, mr,
+                                 where + ".metallicRoughnessTexture");
+  if (!in.metallicRoughness) in.metallicRoughness = std::make_shared<ConstantTexture>(mr);
+
+  if (const tinygltf::Value* ext = extension(m.extensions, "KHR_materials_transmission")) {
+    const std::string w = where + ".extensions.KHR_materials_transmission";
+    const float factor = numberOr(*ext, "transmissionFactor", 0.0f);
+    if (!(factor >= 0.0f && factor <= 1.0f)) fail(w + ".transmissionFactor", "expected a number in [0, 1]");
+    if (ext->Has("transmissionTexture")) {
+      const tinygltf::Value& info = ext->Get("transmissionTexture");
+      const float tex = numberOr(info, "index", -1.0f);
+      if (!(tex >= 0.0f)) fail(w + ".transmissionTexture.index", "expected a texture index");
+      const float texCoord = numberOr(info, "texCoord", 0.0f);
+      if (!(texCoord >= 0.0f && texCoord < 16.0f))
+        fail(w + ".transmissionTexture.texCoord", "expected 0..15");
+      in.transmission = texture(int(tex), int(texCoord),
+                                info.Has("extensions") ? extensionsOf(info) : tinygltf::ExtensionMap{},
+                                Channels::Red, Color(factor), w + ".transmissionTexture");
+    }
+    if (!in.transmission && factor > 0.0f) in.transmission = std::make_shared<ConstantTexture>(Color(factor));
+  }
+  if (const tinygltf::Value* ext = extension(m.extensions, "KHR_materials_ior")) {
+    in.ior = numberOr(*ext, "ior", 1.5f);
+    if (!(in.ior >= 1.0f && in.ior < 10.0f))
+      fail(where + ".extensions.KHR_materials_ior.ior", "expected a number in [1, 10)");
+  }
+  if (const tinygltf::Value* ext = extension(m.extensions, "KHR_materials_volume")) {
+    const float thickness = numberOr(*ext, "thicknessFactor", 0.0f);
+    if (!(thickness >= 0.0f))
+      fail(where + ".extensions.KHR_materials_volume.thicknessFactor", "expected >= 0");
+    in.thinWalled = thickness == 0.0f;
+    if (ext->Has("attenuationDistance"))
+      warn(where + ".extensions.KHR_materials_volume",
+           "attenuationDistance/attenuationColor are not supported; the volume is clear");
+  }
+  const std::string name = m.name.empty() ? "material" + std::to_string(index) : m.name;
+  out.material = scene_.addMaterial(name, std::make_unique<GltfPbrMaterial>(in));
+
+  // Emission: emissiveFactor x KHR_materials_emissive_strength, unscaled (Blender writes both so).
+  if (!m.emissiveFactor.empty()) {
+    if (m.emissiveFactor.size() != 3) fail(where + ".emissiveFactor", "expected 3 numbers");
+    out.emission = Color(float(m.emissiveFactor[0]), float(m.emissiveFactor[1]), float(m.emissiveFactor[2]));
+  }
+  if (const tinygltf::Value* ext = extension(m.extensions, "KHR_materials_emissive_strength")) {
+    const float strength = numberOr(*ext, "emissiveStrength", 1.0f);
+    if (!(strength >= 0.0f && std::isfinite(strength)))
+      fail(where + ".extensions.KHR_materials_emissive_strength.emissiveStrength", "expected a number >= 0");
+    out.emission *= strength;
+  }
+  if (!isFinite(out.emission) || out.emission.x < 0.0f || out.emission.y < 0.0f || out.emission.z < 0.0f)
+    fail(where + ".emissiveFactor", "expected finite numbers >= 0");
+
+  auto maps = std::make_shared<SurfaceMaps>();
+  if (!isBlack(out.emission))
+    maps->emission = texture(m.emissiveTexture, Channels::SrgbRgb, Color(1.0f), where + ".emissiveTexture");
+  if (m.normalTexture.index >= 0) {
+    maps->normalMap = texture(m.normalTexture.index, m.normalTexture.texCoord, m.normalTexture.extensions,
+                              Channels::LinearRgb, Color(1.0f), where + ".normalTexture");
+    maps->normalScale = float(m.normalTexture.scale);
+    if (!std::isfinite(maps->normalScale)) fail(where + ".normalTexture.scale", "expected a number");
+    out.needsTangents = maps->normalMap != nullptr;
+  }
+  if (maps->emission || maps->normalMap) out.maps = std::move(maps);
+
+  // Alpha coverage (section 3.9.4): baseColorFactor.a times the base colour texture's alpha.
+  const std::string alphaMode = m.alphaMode.empty() ? "OPAQUE" : m.alphaMode;
+  if (alphaMode == "MASK" || alphaMode == "BLEND") {
+    const AlphaMode mode = alphaMode == "MASK" ? AlphaMode::Mask : AlphaMode::Blend;
+    const float cutoff = float(m.alphaCutoff);
+    if (!(cutoff >= 0.0f)) fail(where + ".alphaCutoff", "expected a number >= 0");
+    std::shared_ptr<const Texture> alpha =
+        texture(pbr.baseColorTexture, Channels::Alpha, Color(baseFactor.w), where + ".baseColorTexture");
+    const bool opaque = mode == AlphaMode::Mask ? baseFactor.w >= cutoff : baseFactor.w >= 1.0f;
+    if (!alpha && !opaque) alpha = std::make_shared<ConstantTexture>(Color(baseFactor.w));
+    if (alpha) out.opacity = std::make_shared<AlphaOpacity>(std::move(alpha), mode, cutoff);
+  } else if (alphaMode != "OPAQUE") {
+    fail(where + ".alphaMode", "unknown alpha mode '" + alphaMode + "'; valid: OPAQUE, MASK, BLEND");
+  }
+  return out;
+}
+
+std::shared_ptr<const Texture> GltfMaterialReader::texture(const tinygltf::TextureInfo& info,
+                                                           Channels channels, const Color& scale,
+                                                           const std::string& where) {
+  if (info.index < 0) return nullptr;
+  return texture(info.index, info.texCoord, info.extensions, channels, scale, where);
+}
+
+std::shared_ptr<const Texture> GltfMaterialReader::texture(int index, int texCoord,
+                                                           const tinygltf::ExtensionMap& extensions,
+                                                           Channels channels, const Color& scale,
+                                                           const std::string& where) {
+  if (size_t(index) >= model_.textures.size()) fail(where, "texture index out of range");
+  const tinygltf::Texture& tex = model_.textures[size_t(index)];
+  if (tex.source < 0 || size_t(tex.source) >= model_.images.size())
+    fail(where, "texture " + std::to_string(index) + " has no valid image source");
+  const Decoded* img = decode(tex.source, where);
+  if (!img) return nullptr;
+
+  const size_t n = size_t(img->width) * size_t(img->height);
+  const int ch = img->channels;
+  std::vector<Color> texels(n);
+  for (size_t i = 0; i < n; ++i) {
+    const float* p = &img->values[i * size_t(ch)];
+    const Color rgb = ch >= 3 ? Color(p[0], p[1], p[2]) : Color(p[0]);
+    switch (channels) {
+      case Channels::SrgbRgb:
+        texels[i] = Color(srgbToLinear(rgb.x), srgbToLinear(rgb.y), srgbToLinear(rgb.z));
+        break;
+      case Channels::LinearRgb:
+        texels[i] = rgb;
+        break;
+      case Channels::Alpha:
+        texels[i] = Color(ch == 4 ? p[3] : ch == 2 ? p[1] : 1.0f);
+        break;
+      case Channels::MetallicRoughness:
+        texels[i] = Color(0.0f, rgb.y, rgb.z);
+        break;
+      case Channels::Red:
+        texels[i] = Color(rgb.x);
+        break;
+    }
+  }
+  TextureWrap wrapS = TextureWrap::Repeat, wrapT = TextureWrap::Repeat;
+  TextureFilter filter = TextureFilter::Bilinear;
+  if (tex.sampler >= 0) {
+    if (size_t(tex.sampler) >= model_.samplers.size()) fail(where, "sampler index out of range");
+    const tinygltf::Sampler& s = model_.samplers[size_t(tex.sampler)];
+    wrapS = wrapMode(s.wrapS);
+    wrapT = wrapMode(s.wrapT);
+    if (s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST) filter = TextureFilter::Nearest;
+  }
+  std::shared_ptr<const Texture> out =
+      std::make_shared<ImageTexture>(img->width, img->height, std::move(texels), filter, wrapS, wrapT, scale);
+
+  if (const tinygltf::Value* t = extension(extensions, "KHR_texture_transform")) {
+    const std::string w = where + ".extensions.KHR_texture_transform";
+    Vec2 offset(0.0f), scaleUv(1.0f);
+    const float rotation = numberOr(*t, "rotation", 0.0f);
+    for (const char* key : {"offset", "scale"}) {
+      if (!t->Has(key)) continue;
+      const tinygltf::Value& v = t->Get(key);
+      if (!v.IsArray() || v.ArrayLen() != 2 || !v.Get(0).IsNumber() || !v.Get(1).IsNumber())
+        fail(w + "." + key, "expected 2 numbers");
+      const Vec2 value(float(v.Get(0).GetNumberAsDouble()), float(v.Get(1).GetNumberAsDouble()));
+      (std::strcmp(key, "offset") == 0 ? offset : scaleUv) = value;
+    }
+    if (!std::isfinite(rotation) || !isFinite(Vec3(offset, 0.0f)) || !isFinite(Vec3(scaleUv, 0.0f)))
+      fail(w, "expected finite numbers");
+    if (t->Has("texCoord")) {
+      const float tc = numberOr(*t, "texCoord", 0.0f);
+      if (!(tc >= 0.0f && tc < 16.0f)) fail(w + ".texCoord", "expected 0..15");
+      texCoord = int(tc);
+    }
+    out = std::make_shared<UvTransformTexture>(std::move(out), offset, rotation, scaleUv);
+  }
+  if (texCoord != 0)
+    warn(where, "uses TEXCOORD_" + std::to_string(texCoord) + "; Ember reads TEXCOORD_0 only");
+  return out;
+}
+
+const GltfMaterialReader::Decoded* GltfMaterialReader::decode(int image, const std::string& where) {
+  if (const auto it = images_.find(image); it != images_.end())
+    return it->second.values.empty() ? nullptr : &it->second;
+  Decoded& d = images_[image];
+  const tinygltf::Image& img = model_.images[size_t(image)];
+  if (img.width <= 0 || img.height <= 0 || img.image.empty() || (img.bits != 8 && img.bits != 16) ||
+      img.component < 1 || img.component > 4) {
+    warn(where, "image " + std::to_string(image) + " could not be decoded; using the factor alone");
+    return nullptr;
+  }
+  const size_t count = size_t(img.width) * size_t(img.height) * size_t(img.component);
+  if (img.image.size() < count * size_t(img.bits / 8))
+    fail(where, "decoded image is smaller than its size says");
+  d.width = img.width;
+  d.height = img.height;
+  d.channels = img.component;
+  d.values.resize(count);
+  for (size_t i = 0; i < count; ++i) {
+    if (img.bits == 8) {
+      d.values[i] = img.image[i] / 255.0f;
+    } else {
+      uint16_t v;
+      std::memcpy(&v, &img.image[2 * i], 2);
+      d.values[i] = v / 65535.0f;
+    }
+  }
+  return &d;
+}
+
+}  // namespace ember

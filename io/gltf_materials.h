@@ -1,0 +1,56 @@
+// glTF 2.0 materials as Ember sees them (docs/gltf.md has the table): pbrMetallicRoughness with
+// all its textures becomes a GltfPbrMaterial; normal, emissive and alpha textures become a mesh's
+// SurfaceMaps and MeshOpacity; KHR_materials_emissive_strength, _transmission, _ior, _volume
+// (thickness) and KHR_texture_transform are read. Each glTF material is converted once.
+#pragma once
+
+#include "materials/surface_maps.h"
+#include "renderer/scene.h"
+
+#include <tiny_gltf.h>
+
+#include <map>
+#include <string>
+
+namespace ember {
+
+struct GltfSurface {
+  const Material* material = nullptr;
+  Color emission{0.0f};  // emissiveFactor x emissiveStrength
+  std::shared_ptr<const SurfaceMaps> maps;
+  std::shared_ptr<const MeshOpacity> opacity;
+  bool needsTangents = false;
+};
+
+class GltfMaterialReader {
+ public:
+  GltfMaterialReader(const tinygltf::Model& model, const std::string& path, Scene& scene)
+      : model_(model), path_(path), scene_(scene) {}
+
+  // The surface for material index `index` (-1 or out of range: the spec's default material).
+  const GltfSurface& surface(int index);
+
+ private:
+  struct Decoded {  // an image's channels as floats in [0, 1], not yet colour-decoded
+    int width = 0, height = 0, channels = 0;
+    std::vector<float> values;
+  };
+  enum class Channels { SrgbRgb, LinearRgb, Alpha, MetallicRoughness, Red };
+
+  GltfSurface convert(int index);
+  std::shared_ptr<const Texture> texture(const tinygltf::TextureInfo& info, Channels channels,
+                                         const Color& scale, const std::string& where);
+  std::shared_ptr<const Texture> texture(int index, int texCoord, const tinygltf::ExtensionMap& extensions,
+                                         Channels channels, const Color& scale, const std::string& where);
+  const Decoded* decode(int image, const std::string& where);
+  [[noreturn]] void fail(const std::string& where, const std::string& what) const;
+  void warn(const std::string& where, const std::string& what) const;
+
+  const tinygltf::Model& model_;
+  std::string path_;
+  Scene& scene_;
+  std::map<int, GltfSurface> surfaces_;
+  std::map<int, Decoded> images_;
+};
+
+}  // namespace ember
