@@ -31,8 +31,12 @@ Runner addInfoCommand(CLI::App& app) {
     std::printf("scene:      %s\n", path->c_str());
     std::printf("image:      %d x %d, %d spp, max depth %d, Russian roulette from %d, seed %llu\n", rs.width,
                 rs.height, rs.spp, rs.maxDepth, rs.rrDepth, static_cast<unsigned long long>(rs.seed));
-    std::printf("camera:     origin (%g, %g, %g) target (%g, %g, %g) fov_y %g deg\n", c.origin.x, c.origin.y,
-                c.origin.z, c.target.x, c.target.y, c.target.z, c.fovYDeg);
+    std::printf("camera:     origin (%g, %g, %g) target (%g, %g, %g) ", c.origin.x, c.origin.y, c.origin.z,
+                c.target.x, c.target.y, c.target.z);
+    if (c.projection == Projection::Orthographic)
+      std::printf("orthographic, half height %g\n", c.orthoHalfHeight);
+    else
+      std::printf("fov_y %g deg\n", c.fovYDeg);
     std::printf("shapes:     %zu", scene.shapes.size());
     for (const auto& [type, n] : byType) std::printf("  %s %d", type.c_str(), n);
     std::printf("\nmeshes:     %zu (%zu triangles)\n", scene.meshes.size(), scene.triangleCount());

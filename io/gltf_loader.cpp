@@ -1,5 +1,7 @@
 #include "io/gltf_loader.h"
 
+#include "accel/cylinder.h"
+#include "accel/sphere.h"
 #include "io/gltf_materials.h"
 #include "io/input_error.h"
 
@@ -7,9 +9,12 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include <nlohmann/json.hpp>
+
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <set>
 
@@ -17,7 +22,8 @@ namespace ember {
 
 namespace {
 
-constexpr int kModeTriangles = 4, kModeStrip = 5, kModeFan = 6;
+constexpr int kModePoints = 0, kModeLines = 1, kModeLineLoop = 2, kModeLineStrip = 3, kModeTriangles = 4,
+              kModeStrip = 5, kModeFan = 6;
 
 class GltfImporter {
  public:
@@ -56,7 +62,9 @@ class GltfImporter {
         if (!children.count(i)) roots.push_back(i);
     }
     std::vector<int> stack;
+    const size_t firstMesh = scene_.meshes.size();
     for (int root : roots) visit(root, options_.transform, stack);
+    makePointsAndLines(firstMesh);
     if (options_.camera >= 0 && !result_.camera)
       fail("cameras[" + std::to_string(options_.camera) + "]", "no node of the scene uses this camera");
     return result_;
@@ -77,19 +85,47 @@ class GltfImporter {
     const bool ok = ext == ".glb" ? loader.LoadBinaryFromFile(&model_, &err, &warn, path_)
                                   : loader.LoadASCIIFromFile(&model_, &err, &warn, path_);
     if (!ok) {
+      // tinygltf trips over the data of extensions it cannot decode (Draco's missing bufferViews)
+      // before we see the file's extensionsRequired: name the extension rather than its symptom.
+      for (const std::string& ext : requiredExtensions())
+        if (!supportedExtensions().count(ext))
+          fail("extensionsRequired", "the file requires " + ext + ", which Ember does not support");
       while (!err.empty() && (err.back() == '\n' || err.back() == '\r')) err.pop_back();
       throw InputError(path_ + ": cannot load glTF: " + (err.empty() ? "unknown error" : err));
     }
   }
 
-  // Extensions we implement (docs/gltf.md); any other one used is named in one warning, and one
-  // the file requires is an error, since the file cannot be rendered correctly without it.
-  void checkExtensions() const {
+  static const std::set<std::string>& supportedExtensions() {
     static const std::set<std::string> supported = {
         "KHR_lights_punctual",        "KHR_materials_emissive_strength",
         "KHR_materials_transmission", "KHR_materials_ior",
         "KHR_materials_volume",       "KHR_texture_transform",
         "KHR_mesh_quantization"};
+    return supported;
+  }
+
+  // extensionsRequired read straight from the file's JSON (.gltf, or a .glb's JSON chunk); empty
+  // when it cannot be read.
+  std::vector<std::string> requiredExtensions() const {
+    std::ifstream in(path_, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), {});
+    if (bytes.size() >= 20 && bytes.compare(0, 4, "glTF") == 0) {
+      uint32_t length = 0;
+      std::memcpy(&length, bytes.data() + 12, 4);
+      bytes = bytes.substr(20, std::min<size_t>(length, bytes.size() - 20));
+    }
+    std::vector<std::string> out;
+    const nlohmann::json doc = nlohmann::json::parse(bytes, nullptr, /*allow_exceptions=*/false);
+    if (doc.is_object() && doc.contains("extensionsRequired") && doc["extensionsRequired"].is_array())
+      for (const auto& e : doc["extensionsRequired"])
+        if (e.is_string()) out.push_back(e.get<std::string>());
+    return out;
+  }
+
+  // Extensions we implement (docs/gltf.md); any other one used is named in one warning, and one
+  // the file requires is an error, since the file cannot be rendered correctly without it.
+  void checkExtensions() const {
+    const std::set<std::string>& supported = supportedExtensions();
     for (const std::string& ext : model_.extensionsRequired)
       if (!supported.count(ext))
         fail("extensionsRequired", "the file requires " + ext + ", which Ember does not support");
@@ -312,18 +348,84 @@ class GltfImporter {
     for (size_t i = 0; i < acc.count; ++i) fn(base + i * stride, i);
   }
 
+  // glTF points and lines have no width (rasterisers draw them one pixel wide), which a path tracer
+  // cannot see. Ember renders them as small spheres and capped cylinders of a radius relative to the
+  // scene's size (kCurveRadius x the bounds' diagonal), made in makePointsAndLines() once every
+  // primitive is read.
+  static constexpr float kCurveRadius = 0.004f;
+  struct PointsOrLines {
+    std::vector<Vec3> points;
+    std::vector<std::pair<uint32_t, uint32_t>> segments;  // empty for POINTS
+    int material;
+    std::string where;
+  };
+
+  void readPointsOrLines(const tinygltf::Primitive& prim, int mode, const Mat4& world,
+                         const std::vector<float>& positions, size_t vertexCount, const std::string& where) {
+    PointsOrLines item{{}, {}, prim.material, where};
+    for (size_t i = 0; i < vertexCount; ++i)
+      item.points.push_back(
+          Vec3(world * glm::vec4(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2], 1.0f)));
+    std::vector<uint32_t> order;
+    if (prim.indices >= 0) {
+      order = readIndices(prim.indices, where + ".indices");
+      for (uint32_t idx : order)
+        if (idx >= vertexCount) fail(where + ".indices", "index " + std::to_string(idx) + " out of range");
+    } else {
+      for (uint32_t i = 0; i < vertexCount; ++i) order.push_back(i);
+    }
+    if (mode == kModePoints) {
+      std::vector<Vec3> used;
+      for (uint32_t idx : order) used.push_back(item.points[idx]);
+      item.points = std::move(used);
+    } else if (mode == kModeLines) {
+      for (size_t i = 0; i + 1 < order.size(); i += 2) item.segments.emplace_back(order[i], order[i + 1]);
+    } else {
+      for (size_t i = 0; i + 1 < order.size(); ++i) item.segments.emplace_back(order[i], order[i + 1]);
+      if (mode == kModeLineLoop && order.size() > 2) item.segments.emplace_back(order.back(), order.front());
+    }
+    pointsAndLines_.push_back(std::move(item));
+  }
+
+  void makePointsAndLines(size_t firstMesh) {
+    if (pointsAndLines_.empty()) return;
+    Bounds bounds;
+    for (size_t i = firstMesh; i < scene_.meshes.size(); ++i) bounds.extend(scene_.meshes[i].mesh->bounds());
+    for (const PointsOrLines& item : pointsAndLines_)
+      for (const Vec3& p : item.points) bounds.extend(p);
+    const float radius = std::max(kCurveRadius * glm::length(bounds.upper - bounds.lower), 1e-6f);
+    for (const PointsOrLines& item : pointsAndLines_) {
+      const GltfSurface& surface = materials_.surface(item.material);
+      const Material* material = options_.materialOverride ? options_.materialOverride : surface.material;
+      if (item.segments.empty()) {
+        for (const Vec3& p : item.points)
+          scene_.shapes.push_back(
+              {item.where, std::make_unique<Sphere>(p, radius), material, surface.emission});
+        result_.points += item.points.size();
+      }
+      for (const auto& [a, b] : item.segments) {
+        if (item.points[a] == item.points[b]) continue;
+        scene_.shapes.push_back({item.where,
+                                 std::make_unique<Cylinder>(item.points[a], item.points[b], radius, true),
+                                 material, surface.emission});
+        ++result_.segments;
+      }
+    }
+  }
+
   void readPrimitive(const tinygltf::Primitive& prim, const Mat4& world, const std::string& where) {
     const int mode = prim.mode < 0 ? kModeTriangles : prim.mode;
-    if (mode != kModeTriangles && mode != kModeStrip && mode != kModeFan) {
-      std::fprintf(stderr, "ember: %s: %s: skipping a primitive of mode %d (points or lines)\n",
-                   path_.c_str(), where.c_str(), mode);
-      return;
-    }
+    if (mode < kModePoints || mode > kModeFan)
+      fail(where + ".mode", "unknown primitive mode " + std::to_string(mode));
     const auto pos = prim.attributes.find("POSITION");
     if (pos == prim.attributes.end()) fail(where, "primitive has no POSITION attribute");
     size_t vertexCount = 0;
     const std::vector<float> positions =
         readFloats(pos->second, TINYGLTF_TYPE_VEC3, where + ".attributes.POSITION", vertexCount);
+    if (mode != kModeTriangles && mode != kModeStrip && mode != kModeFan) {
+      readPointsOrLines(prim, mode, world, positions, vertexCount, where);
+      return;
+    }
 
     auto mesh = std::make_unique<TriangleMesh>();
     mesh->name = where;
@@ -419,6 +521,7 @@ class GltfImporter {
   GltfMaterialReader materials_;
   GltfImport result_;
   std::set<std::string> usedOverrides_;
+  std::vector<PointsOrLines> pointsAndLines_;
 };
 
 }  // namespace

@@ -26,6 +26,7 @@ struct GltfImport {
   float cameraAspect = 0.0f;           // its aspect ratio, 0 if unspecified
   size_t cameraCount = 0;              // entries in the file's `cameras`
   size_t triangles = 0;
+  size_t points = 0, segments = 0;  // POINTS and LINES primitives, rendered as spheres and cylinders
   size_t primitives = 0;
   size_t lights = 0;                       // KHR_lights_punctual lights placed by nodes
   std::vector<std::string> materialNames;  // every glTF material's name, in file order

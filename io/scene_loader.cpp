@@ -464,9 +464,11 @@ Scene loadGltfScene(const std::string& path, const LoadOptions& load) {
   GltfImportOptions options;
   options.camera = load.camera;
   const GltfImport imported = importGltf(path, scene, options);
-  if (imported.triangles == 0) throw InputError(path + ": the scene contains no triangles to render");
+  if (imported.triangles + imported.points + imported.segments == 0)
+    throw InputError(path + ": the scene contains nothing to render");
   Bounds bounds;
   for (const auto& m : scene.meshes) bounds.extend(m.mesh->bounds());
+  for (const auto& s : scene.shapes) bounds.extend(s.shape->bounds());
   scene.settings.height = 384;
   if (imported.camera) {
     scene.cameraParams = *imported.camera;

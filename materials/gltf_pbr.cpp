@@ -27,7 +27,8 @@
 //    exactly and stays continuous with the specification's Schlick on the outside.
 //  - Sampling: a one-sample mixture of cosine-weighted diffuse, GGX visible normals (Heitz 2018)
 //    reflected, and (transmission > 0) the same visible normal refracted or reflected-and-mirrored.
-//    Lobe probabilities are proportional to cheap weight estimates with the Fresnel term at n.v:
+//    Lobe probabilities are proportional to cheap weight estimates with the Fresnel term at n.v
+//    (capped at 0.9):
 //    specular (1 - m) F_d + m max(F_m), diffuse (1 - m)(1 - F_d)(1 - t) max(baseColor),
 //    transmission (1 - m)(1 - F_d) t max(baseColor). Every strategy reports the full mixture pdf,
 //    and the weight is eval / pdf, so sample(), eval() and pdf() agree exactly. A sampled direction
@@ -60,11 +61,12 @@ GltfPbrMaterial::Params GltfPbrMaterial::fetch(Vec2 uv) const {
   return p;
 }
 
-GltfPbrMaterial::LobeProbabilities GltfPbrMaterial::lobeProbabilities(const Params& p, float cosO) const {
-  // The outside Schlick term at n.v for every side: an estimate only, and one that is < 1 wherever
-  // a lobe can carry energy (an exact inside Fresnel of 1 at n.v would starve the transmission lobe
-  // although microfacets tilted towards wo still refract).
-  const float fd = schlickFresnel(f0_, cosO);
+GltfPbrMaterial::LobeProbabilities GltfPbrMaterial::lobeProbabilities(const Params& p, float cosO,
+                                                                      bool outside) const {
+  // The layer's Fresnel term at n.v, capped below 1 inside a volume: past the critical angle most
+  // visible microfacets reflect totally, but those tilted towards wo still refract, so the
+  // transmission lobe must keep some probability.
+  const float fd = std::min(dielectricFresnel(cosO, outside), 0.9f);
   const float fm = maxComponent(schlickFresnel(p.baseColor, cosO));
   const float dielectric = 1.0f - p.metallic;
   const float base = dielectric * (1.0f - fd) * maxComponent(p.baseColor);
@@ -127,7 +129,11 @@ Color GltfPbrMaterial::evalLocal(const Params& p, const LobeProbabilities& lobes
   if (h.z < 0.0f) h = -h;
   const float cosOH = glm::dot(o, h), cosIH = glm::dot(i, h);
   if (!(cosOH > 0.0f) || !(cosIH < 0.0f)) return Color(0.0f);
-  const float F = dielectricFresnel(cosOH, outside);
+  // Schlick at the outside cosine (see the top comment). Both cosines of a refracting pair are at
+  // hand here, so the outside one is taken directly rather than through Snell's law, whose
+  // cos_t = sqrt(1 - sin_t^2) loses precision near the critical angle: F is then exactly the same
+  // for (wo, wi) and (wi, wo).
+  const float F = schlickFresnel(f0_, outside ? cosOH : -cosIH);
   // Radiance BTDF times |cos_i|: (1 - F) D G2 |i.h| |o.h| / (|o.z| (o.h + eta i.h)^2) (Walter eq. 21
   // divided by eta^2). G2 / |o.z| = 2 |i.z| / (|i.z| root(o) + |o.z| root(i)) stays finite as o.z -> 0.
   const float ai = -i.z;
@@ -145,7 +151,8 @@ Color GltfPbrMaterial::evalAndPdf(const SurfaceHit& hit, const Vec3& wo, const V
   const Vec3 o = frame.toLocal(wo);
   if (!(o.z > 0.0f)) return Color(0.0f);  // wo under the shading hemisphere
   const Params p = fetch(hit.uv);
-  return evalLocal(p, lobeProbabilities(p, o.z), o, frame.toLocal(wi), sameSide(hit, wo, wi), outside, pdf);
+  return evalLocal(p, lobeProbabilities(p, o.z, outside), o, frame.toLocal(wi), sameSide(hit, wo, wi),
+                   outside, pdf);
 }
 
 Color GltfPbrMaterial::eval(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const {
@@ -166,7 +173,7 @@ bool GltfPbrMaterial::sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, floa
   const Vec3 o = frame.toLocal(wo);
   if (!(o.z > 0.0f)) return false;
   const Params p = fetch(hit.uv);
-  const LobeProbabilities lobes = lobeProbabilities(p, o.z);
+  const LobeProbabilities lobes = lobeProbabilities(p, o.z, outside);
 
   Vec3 i;
   bool transmit = false;

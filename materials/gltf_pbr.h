@@ -58,7 +58,7 @@ class GltfPbrMaterial final : public Material {
   };
 
   Params fetch(Vec2 uv) const;
-  LobeProbabilities lobeProbabilities(const Params& p, float cosO) const;
+  LobeProbabilities lobeProbabilities(const Params& p, float cosO, bool outside) const;
   // Fresnel reflectance of the dielectric layer for the cosine between wo and the microfacet normal.
   float dielectricFresnel(float cosOH, bool outside) const;
   // f |cos theta_i| and the mixture pdf of sample() together, in the local frame of the normal that

@@ -114,13 +114,13 @@ struct Ggx {
   float visibleNormalPdf(const Vec3& wo, const Vec3& h) const {
     const float cosOH = glm::dot(wo, h);
     if (wo.z <= 0.0f || cosOH <= 0.0f) return 0.0f;
-    return 2.0f * D(h) * cosOH / (wo.z + root(wo));
+    return D(h) * cosOH / wo.z;  // MUTATION: G1 dropped
   }
   // Density of the direction wi = reflect(wo, h), h a visible normal: D_wo(h) / (4 wo.h) (Heitz
   // 2018 eq. 17) = D(h) / (2 (wo.z + root(wo))); h = normalize(wo + wi).
   float reflectionPdf(const Vec3& wo, const Vec3& h) const {
     if (wo.z <= 0.0f || glm::dot(wo, h) <= 0.0f) return 0.0f;
-    return D(h) / (2.0f * (wo.z + root(wo)));
+    return D(h) / (4.0f * wo.z);  // MUTATION: G1 dropped
   }
 };
 

@@ -59,6 +59,7 @@
 #include "accel/sphere.h"
 #include "accel/triangle.h"
 #include "accel/triangle_mesh.h"
+#include "materials/gltf_pbr.h"
 #include "materials/lambertian.h"
 #include "materials/mixed.h"
 #include "materials/phong.h"
@@ -92,7 +93,7 @@ namespace {
 // Parameters of the test as a whole.
 
 constexpr double kAlpha = 0.01;     // family-wise significance level over every case in the file
-constexpr int kNumCases = 50;       // m for the Sidak correction: must equal allCases().size()
+constexpr int kNumCases = 63;       // m for the Sidak correction: must equal allCases().size()
 constexpr long kSamples = 1000000;  // samples per case
 constexpr double kMinExpected = 5.0;
 // Absolute error allowed on integrals of the pdf over the sphere: the midpoint rule on the
@@ -809,6 +810,48 @@ const std::vector<Chi2Case>& allCases() {
     add("Mixed_allParts_nonDelta_woBelow", [=](uint64_t s) {
       runMaterial(mixed(Color(0.25f), Color(0.25f), Color(0.1f), Color(0.3f), 30.0f), woBelow, s);
     });
+
+    // glTF metallic-roughness (Appendix B + KHR_materials_transmission / _ior): roughness 0.1 to 1
+    // (alpha 0.01 to 1) x metallic 0, 0.5, 1, at normal, oblique, grazing and below-the-surface wo
+    // (two-sided); thin-walled transmission (the mirrored GGX lobe) and a rough refracting
+    // interface from outside and from inside (total internal reflection for part of the visible
+    // normals), whose samples cover the whole sphere.
+    auto pbr = [](float roughness, float metallic, float transmission, bool thinWalled) {
+      GltfPbrInputs in;
+      in.baseColor = constant(Color(0.8f, 0.6f, 0.3f));
+      in.metallicRoughness = constant(Color(0.0f, roughness, metallic));
+      if (transmission > 0.0f) in.transmission = constant(Color(transmission, 0.0f, 0.0f));
+      in.thinWalled = thinWalled;
+      in.ior = 1.5f;
+      return std::make_shared<GltfPbrMaterial>(std::move(in));
+    };
+    struct PbrCase {
+      const char* name;
+      float roughness, metallic, transmission;
+      bool thinWalled;
+      Vec3 wo;
+    };
+    const PbrCase pbrCases[] = {
+        {"GltfPbr_r0p1_m1_woOblique", 0.1f, 1.0f, 0.0f, true, woOblique},
+        {"GltfPbr_r0p1_m0_woNormal", 0.1f, 0.0f, 0.0f, true, woNormal},
+        {"GltfPbr_r0p3_m0_woOblique", 0.3f, 0.0f, 0.0f, true, woOblique},
+        {"GltfPbr_r0p3_m0p5_woGrazing", 0.3f, 0.5f, 0.0f, true, woGrazing},
+        {"GltfPbr_r0p3_m1_woGrazing", 0.3f, 1.0f, 0.0f, true, woGrazing},
+        {"GltfPbr_r0p7_m0p5_woNormal", 0.7f, 0.5f, 0.0f, true, woNormal},
+        {"GltfPbr_r0p7_m0_woBelow", 0.7f, 0.0f, 0.0f, true, woBelow},
+        {"GltfPbr_r1_m0_woGrazing", 1.0f, 0.0f, 0.0f, true, woGrazing},
+        {"GltfPbr_r1_m1_woOblique", 1.0f, 1.0f, 0.0f, true, woOblique},
+        {"GltfPbr_thin_t1_r0p4_woOblique", 0.4f, 0.0f, 1.0f, true, woOblique},
+        {"GltfPbr_volume_t0p5_r0p3_woOblique", 0.3f, 0.0f, 0.5f, false, woOblique},
+        {"GltfPbr_volume_t0p5_r0p5_m0p2_woBelowInside", 0.5f, 0.2f, 0.5f, false, woBelow},
+        {"GltfPbr_volume_t1_r0p2_woGrazingInside", 0.2f, 0.0f, 1.0f, false,
+         Vec3(woGrazing.x, woGrazing.y, -woGrazing.z)},
+    };
+    for (const PbrCase& pc : pbrCases) {
+      add(pc.name, [=](uint64_t s) {
+        runMaterial(pbr(pc.roughness, pc.metallic, pc.transmission, pc.thinWalled), pc.wo, s);
+      });
+    }
 
     // Sphere: cone sampling from outside (near, far, and the small-angle Taylor branch), area
     // sampling from inside; the flipped sphere both ways.

@@ -19,9 +19,10 @@
 //    1 - ln 2. (The loss of single-scattering microfacet models at high roughness is the subject of
 //    Kulla & Conty 2017, "Revisiting Physically Based Shading at Imageworks", and Heitz et al. 2016,
 //    "Multiple-Scattering Microfacet BSDFs with the Smith Model".)
-//  - The Appendix B dielectric never exceeds 1; thin-walled transmission plus reflection add up to
-//    exactly the F = 1 metal lobe (F + (1 - F) = 1 per microfacet); the volumetric interface
-//    conserves energy once the 1 / eta^2 radiance scaling of refraction is taken out.
+//  - The Appendix B dielectric matches independent values (and exceeds 1 towards grazing, as
+//    specified); thin-walled transmission plus reflection add up to exactly the F = 1 metal lobe
+//    (F + (1 - F) = 1 per microfacet); the volumetric interface conserves energy once the
+//    1 / eta^2 radiance scaling of refraction is taken out.
 //  - Reciprocity (Helmholtz for reflection, the eta^2-generalised form for refraction).
 //  - Finite, non-negative eval / pdf / sample weights for random and degenerate directions.
 
@@ -35,6 +36,7 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <numbers>
 #include <sstream>
@@ -195,32 +197,54 @@ TEST(PbrFurnace, WhiteMetalMatchesGgxSingleScatteringAlbedo) {
     EXPECT_NEAR(quad, ref.albedo, quadTol) << what;
     EXPECT_LE(quad, 1.0 + 1e-4) << what;
     mc.expectNear(quad, quadTol, "sampled vs quadrature albedo, " + what);
-    if (ref.roughness <= 0.2f && ref.mu == 1.0) EXPECT_GT(quad, 0.97) << what;
+    if (ref.roughness <= 0.2f && ref.mu == 1.0) {
+      EXPECT_GT(quad, 0.97) << what;
+    }
   }
   // The closed form at normal incidence and alpha = 1.
   EXPECT_NEAR(quadratureAlbedo(*makePbr({Color(1.0f), 1.0f, 1.0f}), direction(1.0), 1.0f, false).reflection,
               1.0 - std::log(2.0), 2e-4);
 }
 
-TEST(PbrFurnace, WhiteDielectricNeverExceedsOne) {
+// Appendix B's dielectric, baseColor 1, no transmission: the Lambertian base is weighted by
+// 1 - F(|V.H|) per direction pair, not by what the specular layer leaves over, so the model is NOT
+// energy conserving: at normal incidence E is 1 - (GGX loss) <= 1, but towards grazing wo the
+// Fresnel-brightened specular layer comes on top of an almost undimmed base and E exceeds 1 (1.68 at
+// roughness 0.1, cos 0.05). The reference values come from an independent double-precision midpoint
+// rule of the Appendix B formulas on a 4000 x 8000 (cos theta, phi) grid (converged to 1e-6 where
+// given; NaN: the narrow lobe is not resolved by that grid). This pins the model as specified.
+struct DielectricReference {
+  float roughness;
+  double mu, albedo;
+};
+constexpr double kUnresolved = std::numeric_limits<double>::quiet_NaN();
+const DielectricReference kDielectricReference[] = {
+    {0.1f, 1.0, kUnresolved}, {0.1f, 0.6, 1.006938}, {0.1f, 0.3, 1.150444}, {0.1f, 0.05, kUnresolved},  //
+    {0.3f, 1.0, 0.999553},    {0.3f, 0.6, 1.008157}, {0.3f, 0.3, 1.117897}, {0.3f, 0.05, 1.326515},     //
+    {0.6f, 1.0, 0.992940},    {0.6f, 0.6, 0.996454}, {0.6f, 0.3, 1.022169}, {0.6f, 0.05, 1.080203},     //
+    {1.0f, 1.0, 0.972228},    {1.0f, 0.6, 0.975100}, {1.0f, 0.3, 0.980069}, {1.0f, 0.05, 1.001306},
+};
+
+TEST(PbrFurnace, WhiteDielectricFollowsAppendixB) {
   uint64_t seed = 100;
-  for (float roughness : {0.1f, 0.3f, 0.6f, 1.0f}) {
-    for (double mu : {1.0, 0.6, 0.3, 0.05}) {
-      const PbrConfig c{Color(1.0f), roughness, 0.0f};
-      const auto m = makePbr(c);
-      const Vec3 wo = direction(mu);
-      const std::string what = describe(c, wo);
-      const double quad = quadratureAlbedo(*m, wo, roughness, false).reflection;
-      const test::McMean mc = sampledAlbedo(*m, wo, 100000, seed++);
-      std::cout << "[pbr] dielectric white furnace: " << what << ": E = " << quad << " (sampled " << mc.mean()
-                << " +- " << mc.standardError() << ")\n";
-      EXPECT_LE(quad, 1.0 + 1e-3) << what;
-      EXPECT_LE(mc.mean(), 1.0 + mc.tolerance()) << what;
-      mc.expectNear(quad, mu < 0.2 ? 4e-3 : 1e-3, "sampled vs quadrature albedo, " + what);
-      // Close to 1: the Lambertian base under the Fresnel layer loses only what the single-scattering
-      // GGX layer loses on top of the Fresnel-weighted reflection.
-      EXPECT_GT(quad, 0.8) << what;
+  for (const DielectricReference& ref : kDielectricReference) {
+    const PbrConfig c{Color(1.0f), ref.roughness, 0.0f};
+    const auto m = makePbr(c);
+    const Vec3 wo = direction(ref.mu);
+    const std::string what = describe(c, wo);
+    const double quad = quadratureAlbedo(*m, wo, c.roughness, false).reflection;
+    const test::McMean mc = sampledAlbedo(*m, wo, 100000, seed++);
+    std::cout << "[pbr] dielectric white furnace: " << what << ": E = " << quad << " (sampled " << mc.mean()
+              << " +- " << mc.standardError() << ")\n";
+    const double quadTol = ref.mu < 0.2 ? 4e-3 : 1e-3;
+    mc.expectNear(quad, quadTol, "sampled vs quadrature albedo, " + what);
+    if (!std::isnan(ref.albedo)) {
+      EXPECT_NEAR(quad, ref.albedo, quadTol) << what;
     }
+    if (ref.mu == 1.0) {
+      EXPECT_LE(quad, 1.0 + 1e-3) << what;
+    }
+    EXPECT_GT(quad, 0.95) << what;
   }
 }
 
@@ -257,7 +281,9 @@ TEST(PbrFurnace, VolumetricInterfaceConservesEnergy) {
       const std::string what = describe(c, wo);
       const test::McMean mc = sampledAlbedo(*m, wo, 100000, seed++, /*undoEta=*/true);
       EXPECT_LE(mc.mean(), 1.0 + mc.tolerance()) << what;
-      if (roughness <= 0.05f) EXPECT_GT(mc.mean(), 0.97) << what;
+      if (roughness <= 0.05f) {
+        EXPECT_GT(mc.mean(), 0.97) << what;
+      }
     }
   }
   // eta reported on refraction: eta_t / eta_i.
