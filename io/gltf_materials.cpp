@@ -114,9 +114,24 @@ GltfSurface GltfMaterialReader::convert(int index) {
     if (!(thickness >= 0.0f))
       fail(where + ".extensions.KHR_materials_volume.thicknessFactor", "expected >= 0");
     in.thinWalled = thickness == 0.0f;
-    if (ext->Has("attenuationDistance"))
-      warn(where + ".extensions.KHR_materials_volume",
-           "attenuationDistance/attenuationColor are not supported; the volume is clear");
+    // Attenuation: radiance falls to attenuationColor over attenuationDistance (default infinity).
+    const float distance = numberOr(*ext, "attenuationDistance", std::numeric_limits<float>::infinity());
+    if (!(distance > 0.0f))
+      fail(where + ".extensions.KHR_materials_volume.attenuationDistance", "expected > 0");
+    Color color(1.0f);
+    if (ext->Has("attenuationColor")) {
+      const tinygltf::Value& c = ext->Get("attenuationColor");
+      if (!c.IsArray() || c.ArrayLen() != 3)
+        fail(where + ".extensions.KHR_materials_volume.attenuationColor", "expected 3 numbers");
+      for (int k = 0; k < 3; ++k)
+        color[k] = c.Get(k).IsNumber() ? float(c.Get(k).GetNumberAsDouble()) : -1.0f;
+      if (!(color.x >= 0.0f && color.y >= 0.0f && color.z >= 0.0f && color.x <= 1.0f && color.y <= 1.0f &&
+            color.z <= 1.0f))
+        fail(where + ".extensions.KHR_materials_volume.attenuationColor", "expected numbers in [0, 1]");
+    }
+    if (std::isfinite(distance))
+      for (int k = 0; k < 3; ++k)  // a colour of 0 absorbs everything: a large finite coefficient
+        in.absorption[k] = color[k] > 0.0f ? -std::log(color[k]) / distance : 1e30f;
   }
   const std::string name = m.name.empty() ? "material" + std::to_string(index) : m.name;
   out.material = scene_.addMaterial(name, std::make_unique<GltfPbrMaterial>(in));

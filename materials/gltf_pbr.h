@@ -32,6 +32,9 @@ struct GltfPbrInputs {
   // the surface without bending. With a volume (thicknessFactor > 0) the surface is a refracting
   // interface whose inside lies opposite the outward geometric normal.
   bool thinWalled = true;
+  // KHR_materials_volume attenuation as an absorption coefficient per unit length,
+  // sigma = -ln(attenuationColor) / attenuationDistance; 0 = a clear volume. Unused when thin-walled.
+  Color absorption{0.0f};
 };
 
 class GltfPbrMaterial final : public Material {
@@ -42,6 +45,11 @@ class GltfPbrMaterial final : public Material {
   Color eval(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const override;
   float pdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const override;
   bool sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float uLobe, BsdfSample& out) const override;
+
+  // Beer-Lambert through the volume (KHR_materials_volume): exp(-sigma d).
+  Color interiorTransmittance(float distance) const override {
+    return refracts_ ? glm::exp(-inputs_.absorption * distance) : Color(1.0f);
+  }
 
   const GltfPbrInputs& inputs() const { return inputs_; }
 

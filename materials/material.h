@@ -31,6 +31,11 @@ class Material {
 
   // Whether eval can be non-zero, i.e. light sampling is worth a shadow ray.
   virtual bool hasNonDeltaLobes() const { return true; }
+
+  // Fraction of radiance surviving `distance` through the medium this surface encloses (Beer-Lambert;
+  // 1 for surfaces without an absorbing interior). Applied to path segments that reach the surface
+  // from inside, i.e. against its outward geometric normal: correct for closed, non-nested objects.
+  virtual Color interiorTransmittance(float /*distance*/) const { return Color(1.0f); }
 };
 
 // wo and wi on the same geometric side of the surface (a reflection, not a transmission).

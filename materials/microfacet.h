@@ -94,7 +94,8 @@ struct Ggx {
 
   // Visible normal h for wo (wo.z > 0) by Heitz 2018, listing 1: stretch wo to the hemisphere
   // configuration (alpha = 1), sample the projected hemisphere (a disc, its far half squashed by
-  // s = (1 + Vh.z) / 2), lift back onto the hemisphere and unstretch.
+  // s = (1 + Vh.z) / 2), lift back onto the hemisphere and unstretch. (The listing clamps nh.z at 0;
+  // 1e-7 keeps a sample exactly at the horizon of the hemisphere from becoming h.z = 0, where D = 0.)
   Vec3 sampleVisibleNormal(const Vec3& wo, Vec2 u) const {
     const Vec3 vh = glm::normalize(Vec3(alpha * wo.x, alpha * wo.y, wo.z));
     const float lensq = vh.x * vh.x + vh.y * vh.y;
@@ -114,13 +115,13 @@ struct Ggx {
   float visibleNormalPdf(const Vec3& wo, const Vec3& h) const {
     const float cosOH = glm::dot(wo, h);
     if (wo.z <= 0.0f || cosOH <= 0.0f) return 0.0f;
-    return D(h) * cosOH / wo.z;  // MUTATION: G1 dropped
+    return 2.0f * D(h) * cosOH / (wo.z + root(wo));
   }
   // Density of the direction wi = reflect(wo, h), h a visible normal: D_wo(h) / (4 wo.h) (Heitz
   // 2018 eq. 17) = D(h) / (2 (wo.z + root(wo))); h = normalize(wo + wi).
   float reflectionPdf(const Vec3& wo, const Vec3& h) const {
     if (wo.z <= 0.0f || glm::dot(wo, h) <= 0.0f) return 0.0f;
-    return D(h) / (4.0f * wo.z);  // MUTATION: G1 dropped
+    return D(h) / (2.0f * (wo.z + root(wo)));
   }
 };
 

@@ -52,6 +52,10 @@ Color PathIntegrator::Li(const Scene& scene, Ray ray, Sampler& sampler, PathStat
     }
     ++stats.vertices;
     const Vec3 wo = -ray.dir;
+    if (hit.material && glm::dot(ray.dir, hit.ng) > 0.0f) {
+      throughput *= hit.material->interiorTransmittance(hit.t);
+      if (isBlack(throughput)) break;
+    }
 
     const Color emitted = hit.emitted(wo);
     if (!isBlack(emitted)) {

@@ -114,13 +114,16 @@ TEST(GltfMaterials, RoughMetalLosesOnlyTheEnergySingleScatteringGgxLoses) {
     const float sigma = std::sqrt(film.varianceOfMean().at(0, 0).x);
     EXPECT_NEAR(film.mean().at(0, 0).x, expected, 5.0 * sigma + 2e-3) << "roughness " << roughness;
     EXPECT_LT(expected, 1.0);
-    // Published values for context (Kulla & Conty 2017): single scattering loses ~ 0.2-0.4 at
-    // alpha = 1; ours at normal incidence:
+    // At alpha = 1 the quadrature gives 1 - ln 2 = 0.307 (tests/test_pbr.cpp derives it): half the
+    // visible normals reflect below the horizon, the single-scattering loss Kulla & Conty 2017
+    // correct with a multiple-scattering term, which the glTF model does not have.
     RecordProperty("E_roughness_" + std::to_string(roughness), std::to_string(expected));
   }
 }
 
-TEST(GltfMaterials, WhiteDielectricNeverReflectsMoreThanItReceives) {
+// Appendix B's dielectric is not energy conserving towards grazing angles (materials/gltf_pbr.cpp
+// explains why), but a white sphere under a white sky stays close to 1 overall.
+TEST(GltfMaterials, WhiteDielectricSphereIsCloseToOneUnderAWhiteSky) {
   TempDir dir;
   GltfBuilder b;
   const float c[3] = {0, 0, 0};
@@ -133,10 +136,11 @@ TEST(GltfMaterials, WhiteDielectricNeverReflectsMoreThanItReceives) {
   double sum = 0.0;
   for (int y = 0; y < 10; ++y)
     for (int x = 0; x < 10; ++x) {
-      EXPECT_LT(mean.at(x, y).x, 1.0f + 5.0f * std::sqrt(var.at(x, y).x) + 1e-5f);
+      EXPECT_LT(mean.at(x, y).x, 1.1f + 5.0f * std::sqrt(var.at(x, y).x)) << x << "," << y;
       sum += mean.at(x, y).x;
     }
-  EXPECT_GT(sum / 100.0, 0.9);
+  EXPECT_NEAR(sum / 100.0, 1.0, 0.03);
+  RecordProperty("image_mean", std::to_string(sum / 100.0));
 }
 
 // A 4 x 4 RGB texture of random bytes on an emissive quad: at every texel centre the rendered
@@ -425,6 +429,43 @@ TEST(GltfTransmission, ThinWalledSmoothTransmissionShowsTheBackdrop) {
   const Film film = renderAlpha(dir, dir.file("glass.gltf"), 0.0f, 256, 3);
   // Head-on, Schlick with f0 = 0.04 reflects 4%: the rest of the backdrop comes through unbent.
   EXPECT_NEAR(film.mean().at(0, 0).z, 0.96f, 0.02f);
+}
+
+}  // namespace
+}  // namespace ember
+
+namespace ember {
+namespace {
+
+// A smooth glass ball (KHR_materials_volume, so it refracts) seen head-on through its centre in
+// front of an emissive backdrop; with attenuationColor c over attenuationDistance 1 the light that
+// crosses its diameter d = 1 is scaled by c^d (Beer-Lambert), everything else being equal.
+Color glassBall(const TempDir& dir, const std::string& name, double attenuationColor) {
+  GltfBuilder b;
+  tinygltf::Material m = pbr("glass", {1, 1, 1, 1}, 0, 0);
+  using V = tinygltf::Value;
+  m.extensions["KHR_materials_transmission"] = V(V::Object{{"transmissionFactor", V(1.0)}});
+  V::Object volume{{"thicknessFactor", V(1.0)}};
+  if (attenuationColor < 1.0) {
+    volume["attenuationDistance"] = V(1.0);
+    volume["attenuationColor"] = V(V::Array{V(attenuationColor), V(attenuationColor), V(attenuationColor)});
+  }
+  m.extensions["KHR_materials_volume"] = V(volume);
+  b.model().extensionsUsed = {"KHR_materials_transmission", "KHR_materials_volume"};
+  const float c[3] = {0, 0, 0};
+  b.addSphere(c, 0.5f, b.addMaterial(m));
+  EXPECT_TRUE(b.write(dir.file(name)));
+  const Film film = renderAlpha(dir, dir.file(name), 0.0f, 1024, 6);
+  return film.mean().at(0, 0);
+}
+
+TEST(GltfTransmission, VolumeAttenuationFollowsBeerLambert) {
+  TempDir dir;
+  const Color clear = glassBall(dir, "clear.gltf", 1.0);
+  // Two smooth interfaces at normal incidence pass (1 - 0.04)^2 of the backdrop.
+  EXPECT_NEAR(clear.z, 0.9216f, 0.01f);
+  const Color tinted = glassBall(dir, "tinted.gltf", 0.5);
+  EXPECT_NEAR(tinted.z / clear.z, 0.5f, 0.01f);
 }
 
 }  // namespace
