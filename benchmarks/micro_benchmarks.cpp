@@ -89,7 +89,21 @@ void BM_ShapeOccluded(benchmark::State& state) {
 BENCHMARK(BM_ShapeIntersect)->DenseRange(0, 6);
 BENCHMARK(BM_ShapeOccluded)->DenseRange(0, 6);
 
+// The glTF metallic-roughness material: 0 dielectric (roughness 0.5), 1 metal (roughness 0.3),
+// 2 half metallic, 3 thin-walled transmission, 4 volumetric transmission (refraction).
+std::unique_ptr<Material> makeGltfPbr(int kind) {
+  GltfPbrInputs in;
+  in.baseColor = std::make_shared<ConstantTexture>(Color(0.8f, 0.6f, 0.3f));
+  const float roughness = kind == 1 ? 0.3f : 0.5f, metallic = kind == 1 ? 1.0f : (kind == 2 ? 0.5f : 0.0f);
+  in.metallicRoughness = std::make_shared<ConstantTexture>(Color(0.0f, roughness, metallic));
+  if (kind >= 3) in.transmission = std::make_shared<ConstantTexture>(Color(1.0f, 0.0f, 0.0f));
+  in.thinWalled = kind != 4;
+  return std::make_unique<GltfPbrMaterial>(std::move(in));
+}
+
+// 0-4: Ember's own materials; 5-9: the glTF material in the configurations of makeGltfPbr.
 std::unique_ptr<Material> makeMaterial(int kind) {
+  if (kind >= 5) return makeGltfPbr(kind - 5);
   auto kd = std::make_shared<ConstantTexture>(Color(0.5f));
   switch (kind) {
     case 0:
@@ -110,7 +124,16 @@ std::unique_ptr<Material> makeMaterial(int kind) {
     }
   }
 }
-const char* kMaterialNames[] = {"lambertian", "phong", "mirror", "dielectric", "mixed"};
+const char* kMaterialNames[] = {"lambertian",
+                                "phong",
+                                "mirror",
+                                "dielectric",
+                                "mixed",
+                                "gltf dielectric r0.5",
+                                "gltf metal r0.3",
+                                "gltf metallic 0.5",
+                                "gltf thin transmission",
+                                "gltf volume transmission"};
 
 SurfaceHit flatHit() {
   SurfaceHit hit;
@@ -147,53 +170,8 @@ void BM_MaterialEval(benchmark::State& state) {
   state.SetItemsProcessed(int64_t(state.iterations()));
   state.SetLabel(kMaterialNames[state.range(0)]);
 }
-BENCHMARK(BM_MaterialSample)->DenseRange(0, 4);
-BENCHMARK(BM_MaterialEval)->DenseRange(0, 4);
-
-// The glTF metallic-roughness material: 0 dielectric (roughness 0.5), 1 metal (roughness 0.3),
-// 2 half metallic, 3 thin-walled transmission, 4 volumetric transmission (refraction).
-std::unique_ptr<Material> makeGltfPbr(int kind) {
-  GltfPbrInputs in;
-  in.baseColor = std::make_shared<ConstantTexture>(Color(0.8f, 0.6f, 0.3f));
-  const float roughness = kind == 1 ? 0.3f : 0.5f, metallic = kind == 1 ? 1.0f : (kind == 2 ? 0.5f : 0.0f);
-  in.metallicRoughness = std::make_shared<ConstantTexture>(Color(0.0f, roughness, metallic));
-  if (kind >= 3) in.transmission = std::make_shared<ConstantTexture>(Color(1.0f, 0.0f, 0.0f));
-  in.thinWalled = kind != 4;
-  return std::make_unique<GltfPbrMaterial>(std::move(in));
-}
-const char* kGltfPbrNames[] = {"dielectric r0.5", "metal r0.3", "metallic 0.5", "thin transmission",
-                               "volume transmission"};
-
-void BM_GltfPbrSample(benchmark::State& state) {
-  const auto material = makeGltfPbr(int(state.range(0)));
-  const SurfaceHit hit = flatHit();
-  const Vec3 wo = glm::normalize(Vec3(0.3f, 0.1f, 0.9f));
-  Rng rng(3, 3);
-  BsdfSample bs;
-  for (auto _ : state) {
-    const Vec2 u(rng.uniform(), rng.uniform());
-    benchmark::DoNotOptimize(material->sample(hit, wo, u, rng.uniform(), bs));
-    benchmark::DoNotOptimize(bs);
-  }
-  state.SetItemsProcessed(int64_t(state.iterations()));
-  state.SetLabel(kGltfPbrNames[state.range(0)]);
-}
-// eval and pdf of directions on both sides (transmission too), as light sampling asks for them.
-void BM_GltfPbrEval(benchmark::State& state) {
-  const auto material = makeGltfPbr(int(state.range(0)));
-  const SurfaceHit hit = flatHit();
-  const Vec3 wo = glm::normalize(Vec3(0.3f, 0.1f, 0.9f));
-  Rng rng(3, 3);
-  for (auto _ : state) {
-    const Vec3 wi = sampleUniformSphere(Vec2(rng.uniform(), rng.uniform()));
-    benchmark::DoNotOptimize(material->eval(hit, wo, wi));
-    benchmark::DoNotOptimize(material->pdf(hit, wo, wi));
-  }
-  state.SetItemsProcessed(int64_t(state.iterations()));
-  state.SetLabel(kGltfPbrNames[state.range(0)]);
-}
-BENCHMARK(BM_GltfPbrSample)->DenseRange(0, 4);
-BENCHMARK(BM_GltfPbrEval)->DenseRange(0, 4);
+BENCHMARK(BM_MaterialSample)->DenseRange(0, 9);
+BENCHMARK(BM_MaterialEval)->DenseRange(0, 9);
 
 void BM_Rng(benchmark::State& state) {
   Rng rng(1, 2);

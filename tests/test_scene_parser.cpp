@@ -112,7 +112,7 @@ TEST(SceneParser, MissingFileIsReported) {
 }
 
 TEST(SceneParser, SharedSceneVersionsLoad) {
-  for (const char* name : {"cornell-area", "cornell-point", "shapes", "textured", "demo"}) {
+  for (const char* name : {"cornell-area", "cornell-point", "shapes", "textured", "demo", "gltf-mixed"}) {
     const Scene scene = loadScene(test::sourcePath(std::string("scenes/") + name + ".json"));
     EXPECT_FALSE(scene.shapes.empty()) << name;
   }

@@ -35,7 +35,7 @@ def sky(path, w=512, h=256):
     img = np.where(d[..., 1:2] < 0, ground, img)
     sun = np.array([-0.55, 0.6, 0.58])
     sun /= np.linalg.norm(sun)
-    img += (np.einsum("ijk,k->ij", d, sun) > math.cos(math.radians(2.5)))[..., None] * np.array([900.0, 820.0, 700.0])
+    img += (np.einsum("ijk,k->ij", d, sun) > math.cos(math.radians(6.0)))[..., None] * np.array([160.0, 146.0, 125.0])
     pfm = path[:-4] + ".pfm"
     with open(pfm, "wb") as f:  # PFM stores the bottom row first
         f.write(b"PF\n%d %d\n-1.0\n" % (w, h))
@@ -115,7 +115,7 @@ def uv_sphere(radius, rings=48, segments=96):
 
 def sphere_grid(path):
     g = Gltf()
-    pos, nrm, uv, idx = uv_sphere(0.42)
+    pos, nrm, uv, idx = uv_sphere(0.36)
     for row in range(5):
         for col in range(5):
             metallic, roughness = row / 4, col / 4
