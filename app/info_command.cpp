@@ -14,7 +14,7 @@ Runner addInfoCommand(CLI::App& app) {
   cmd->add_option("scene", *path, "Scene file: Ember JSON, .gltf or .glb")->required();
   return [path] {
     Scene scene = loadScene(*path);
-    const size_t pointLights = scene.lights.size();
+    const size_t punctualLights = scene.lights.size();  // point, spot, directional: before build() adds more
     scene.build();
     std::map<std::string, int> byType;
     int emitters = 0;
@@ -40,7 +40,7 @@ Runner addInfoCommand(CLI::App& app) {
     std::printf("shapes:     %zu", scene.shapes.size());
     for (const auto& [type, n] : byType) std::printf("  %s %d", type.c_str(), n);
     std::printf("\nmeshes:     %zu (%zu triangles)\n", scene.meshes.size(), scene.triangleCount());
-    std::printf("lights:     %zu point, %d area, %zu emissive triangles, %s environment\n", pointLights,
+    std::printf("lights:     %zu punctual, %d area, %zu emissive triangles, %s environment\n", punctualLights,
                 emitters, emissiveTriangles, scene.environment() ? "1" : "no");
     std::printf("materials:  %zu", scene.materials.size());
     for (size_t i = 0; i < scene.materials.size(); ++i)
