@@ -44,6 +44,9 @@ class GltfPbrMaterial final : public Material {
   std::string_view typeName() const override { return "gltf_pbr"; }
   Color eval(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const override;
   float pdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const override;
+  Color evalPdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi, float& pdfOut) const override {
+    return evalAndPdf(hit, wo, wi, pdfOut);
+  }
   bool sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float uLobe, BsdfSample& out) const override;
 
   // Beer-Lambert through the volume (KHR_materials_volume): exp(-sigma d).

@@ -26,6 +26,12 @@ class Material {
   virtual Color eval(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const = 0;
   // Solid-angle density with which sample() produces wi through its non-delta lobes.
   virtual float pdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const = 0;
+  // eval and pdf together, for next-event estimation, which needs both; materials whose two share
+  // most of their work (a microfacet model) override it to do that work once.
+  virtual Color evalPdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi, float& pdfOut) const {
+    pdfOut = pdf(hit, wo, wi);
+    return eval(hit, wo, wi);
+  }
   // Samples wi; uLobe picks among lobes, u the direction within one. False: the path is absorbed.
   virtual bool sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float uLobe, BsdfSample& out) const = 0;
 

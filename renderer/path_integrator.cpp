@@ -11,7 +11,8 @@ Color PathIntegrator::sampleLight(const Scene& scene, const SurfaceHit& hit, con
   const Vec2 u = sampler.get2D();
   LightSample ls;
   if (!light || !light->sample(hit.p, u, ls) || ls.pdf <= 0.0f || isBlack(ls.Li)) return Color(0.0f);
-  const Color f = hit.material->eval(hit, wo, ls.wi);
+  float bsdfPdf = 0.0f;
+  const Color f = hit.material->evalPdf(hit, wo, ls.wi, bsdfPdf);
   if (isBlack(f)) return Color(0.0f);
 
   const Vec3 origin = offsetRayOrigin(hit.p, hit.ng, ls.wi, hit.t);
@@ -24,7 +25,7 @@ Color PathIntegrator::sampleLight(const Scene& scene, const SurfaceHit& hit, con
   if (scene.occluded(origin, ls.wi, dist)) return Color(0.0f);
 
   const float lightPdf = pick * ls.pdf;
-  const float weight = ls.delta ? 1.0f : powerHeuristic(lightPdf, hit.material->pdf(hit, wo, ls.wi));
+  const float weight = ls.delta ? 1.0f : powerHeuristic(lightPdf, bsdfPdf);
   return f * ls.Li * (weight / lightPdf);
 }
 
