@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <random>
 
 namespace ember {
@@ -466,6 +467,80 @@ TEST(GltfTransmission, VolumeAttenuationFollowsBeerLambert) {
   EXPECT_NEAR(clear.z, 0.9216f, 0.01f);
   const Color tinted = glassBall(dir, "tinted.gltf", 0.5);
   EXPECT_NEAR(tinted.z / clear.z, 0.5f, 0.01f);
+}
+
+}  // namespace
+}  // namespace ember
+
+namespace ember {
+namespace {
+
+// Bad material, texture and camera values: an InputError that names the file and the glTF path,
+// never a crash, and no output file from the command line.
+TEST(GltfErrors, BadMaterialValuesNameTheirPlace) {
+  using V = tinygltf::Value;
+  struct Case {
+    const char* name;
+    std::function<void(GltfBuilder&, tinygltf::Material&)> corrupt;
+    const char* expected;
+  };
+  const Case cases[] = {
+      {"texture index",
+       [](GltfBuilder&, tinygltf::Material& m) { m.pbrMetallicRoughness.baseColorTexture.index = 9; },
+       "materials[0].baseColorTexture: texture index out of range"},
+      {"alpha mode", [](GltfBuilder&, tinygltf::Material& m) { m.alphaMode = "SOMETIMES"; },
+       "materials[0].alphaMode: unknown alpha mode 'SOMETIMES'; valid: OPAQUE, MASK, BLEND"},
+      {"ior",
+       [](GltfBuilder&, tinygltf::Material& m) {
+         m.extensions["KHR_materials_ior"] = V(V::Object{{"ior", V(0.5)}});
+       },
+       "materials[0].extensions.KHR_materials_ior.ior: expected a number in [1, 10)"},
+      {"transmission",
+       [](GltfBuilder&, tinygltf::Material& m) {
+         m.extensions["KHR_materials_transmission"] = V(V::Object{{"transmissionFactor", V(2.0)}});
+       },
+       "KHR_materials_transmission.transmissionFactor: expected a number in [0, 1]"},
+      {"texture transform",
+       [](GltfBuilder& b, tinygltf::Material& m) {
+         m.emissiveFactor = {1, 1, 1};
+         m.emissiveTexture.index = b.addTexture(1, 1, 3, {255, 255, 255});
+         m.emissiveTexture.extensions["KHR_texture_transform"] =
+             V(V::Object{{"offset", V(V::Array{V(1.0)})}});
+       },
+       "materials[0].emissiveTexture.extensions.KHR_texture_transform.offset: expected 2 numbers"},
+      {"sampler",
+       [](GltfBuilder& b, tinygltf::Material& m) {
+         m.pbrMetallicRoughness.baseColorTexture.index = b.addTexture(1, 1, 3, {255, 255, 255});
+         b.model().textures.back().sampler = 5;
+       },
+       "materials[0].baseColorTexture: sampler index out of range"},
+      {"attenuation colour",
+       [](GltfBuilder&, tinygltf::Material& m) {
+         m.extensions["KHR_materials_volume"] = V(V::Object{
+             {"thicknessFactor", V(1.0)}, {"attenuationColor", V(V::Array{V(1.0), V(2.0), V(1.0)})}});
+       },
+       "KHR_materials_volume.attenuationColor: expected numbers in [0, 1]"},
+  };
+  for (const Case& c : cases) {
+    TempDir dir;
+    GltfBuilder b;
+    tinygltf::Material m = pbr("paint", {0.5, 0.5, 0.5, 1}, 0, 1);
+    c.corrupt(b, m);
+    b.addQuad(1.0f, b.addMaterial(m));
+    const std::string path = dir.file("bad.gltf");
+    ASSERT_TRUE(b.write(path)) << c.name;
+    try {
+      loadScene(path);
+      ADD_FAILURE() << c.name << ": loaded without error";
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_EQ(msg.rfind(path + ": ", 0), 0u) << c.name << ": " << msg;
+      EXPECT_NE(msg.find(c.expected), std::string::npos) << c.name << ": " << msg;
+    }
+    const auto r = test::runEmber("render '" + path + "' -q --spp 1 -o " + dir.file("out.exr"));
+    EXPECT_EQ(r.exitCode, 1) << c.name << ": " << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("out.exr"))) << c.name;
+  }
 }
 
 }  // namespace
