@@ -463,11 +463,11 @@ class GltfImporter {
       if (n != vertexCount) fail(where + ".attributes.TANGENT", "count differs from POSITION");
       mesh->tangents.resize(n);
       const glm::mat3 linear(world);  // tangents are directions on the surface: transformed like edges
+      // A mirroring transform flips the handedness of the (T, B, N) frame.
+      const float handedness = glm::determinant(linear) < 0.0f ? -1.0f : 1.0f;
       for (size_t i = 0; i < n; ++i) {
         const Vec3 t = linear * Vec3(tangents[4 * i], tangents[4 * i + 1], tangents[4 * i + 2]);
-        // A mirroring transform flips the handedness of the (T, B, N) frame.
-        const float det = glm::determinant(linear);
-        mesh->tangents[i] = glm::vec4(t, tangents[4 * i + 3] * (det < 0.0f ? -1.0f : 1.0f));
+        mesh->tangents[i] = glm::vec4(t, tangents[4 * i + 3] * handedness);
       }
     }
 

@@ -158,7 +158,6 @@ GltfSurface GltfMaterialReader::convert(int index) {
                               Channels::LinearRgb, Color(1.0f), where + ".normalTexture");
     maps->normalScale = float(m.normalTexture.scale);
     if (!std::isfinite(maps->normalScale)) fail(where + ".normalTexture.scale", "expected a number");
-    out.needsTangents = maps->normalMap != nullptr;
   }
   if (maps->emission || maps->normalMap) out.maps = std::move(maps);
 

@@ -19,7 +19,6 @@ struct GltfSurface {
   Color emission{0.0f};  // emissiveFactor x emissiveStrength
   std::shared_ptr<const SurfaceMaps> maps;
   std::shared_ptr<const MeshOpacity> opacity;
-  bool needsTangents = false;
 };
 
 class GltfMaterialReader {

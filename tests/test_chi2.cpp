@@ -68,6 +68,7 @@
 #include "renderer/light_sampler.h"
 #include "renderer/rng.h"
 #include "renderer/sampling.h"
+#include "test_fixtures.h"
 
 #include <gtest/gtest.h>
 
@@ -437,13 +438,7 @@ bool densitiesAgree(double a, double b) {
 // ---------------------------------------------------------------------------------------------
 // Materials.
 
-SurfaceHit flatHit() {
-  SurfaceHit hit;
-  hit.p = Vec3(0.0f);
-  hit.ng = hit.ns = Vec3(0.0f, 0.0f, 1.0f);
-  hit.uv = Vec2(0.5f);
-  return hit;
-}
+using test::flatHit;
 
 std::shared_ptr<const Texture> constant(const Color& c) {
   return std::make_shared<ConstantTexture>(c);

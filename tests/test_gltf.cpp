@@ -6,8 +6,7 @@
 #include "io/gltf_loader.h"
 #include "io/input_error.h"
 #include "io/scene_loader.h"
-#include "renderer/path_integrator.h"
-#include "renderer/render.h"
+#include "test_fixtures.h"
 #include "test_paths.h"
 
 #include <gtest/gtest.h>
@@ -41,12 +40,7 @@ double meanLuminance(const std::string& path, int width, int height, int spp) {
   scene.settings.width = width;
   scene.settings.height = height;
   scene.build();
-  const PathIntegrator integrator(-1, 5);
-  Film film(width, height);
-  RenderOptions options;
-  options.spp = spp;
-  render(scene, integrator, options, film);
-  const Image img = film.mean();
+  const Image img = test::renderFilm(scene, spp, 0).mean();
   double sum = 0.0;
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) sum += luminance(img.at(x, y));

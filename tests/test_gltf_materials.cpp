@@ -5,8 +5,7 @@
 #include "io/input_error.h"
 #include "io/scene_loader.h"
 #include "materials/texture.h"
-#include "renderer/path_integrator.h"
-#include "renderer/render.h"
+#include "test_fixtures.h"
 
 #include <gtest/gtest.h>
 
@@ -21,13 +20,7 @@ using test::TempDir;
 
 Film renderScene(Scene& scene, int spp, uint64_t seed = 1) {
   scene.build();
-  const PathIntegrator integrator(scene.settings.maxDepth, scene.settings.rrDepth);
-  Film film(scene.settings.width, scene.settings.height);
-  RenderOptions options;
-  options.spp = spp;
-  options.seed = seed;
-  render(scene, integrator, options, film);
-  return film;
+  return test::renderFilm(scene, spp, seed);
 }
 
 tinygltf::Material pbr(const std::string& name, std::vector<double> base, double metallic, double roughness) {

@@ -33,6 +33,7 @@
 #include <gtest/gtest.h>
 
 #include "mc_mean.h"
+#include "test_fixtures.h"
 
 #include <cmath>
 #include <functional>
@@ -73,13 +74,7 @@ std::string describe(const PbrConfig& c, const Vec3& wo) {
   return s.str();
 }
 
-SurfaceHit flatHit() {
-  SurfaceHit hit;
-  hit.p = Vec3(0.0f);
-  hit.ng = hit.ns = Vec3(0.0f, 0.0f, 1.0f);
-  hit.uv = Vec2(0.5f);
-  return hit;
-}
+using test::flatHit;
 
 // Unit direction with cos theta = mu (negative: below the surface), at an azimuth in no special
 // relation to the grids.

@@ -17,6 +17,7 @@
 #include "materials/lambertian.h"
 #include "renderer/path_integrator.h"
 #include "renderer/render.h"
+#include "test_fixtures.h"
 #include "test_paths.h"
 
 #include <gtest/gtest.h>
@@ -40,13 +41,8 @@ Rendered renderScene(const std::string& name, uint64_t seed, int spp,
   Scene scene = loadJsonScene(test::sourcePath("scenes/" + name + ".json"));
   if (mutate) mutate(scene);
   scene.build();
-  const PathIntegrator integrator(scene.settings.maxDepth, scene.settings.rrDepth);
-  Film film(scene.settings.width, scene.settings.height);
-  RenderOptions options;
-  options.spp = spp;
-  options.seed = seed;
-  options.sampler = sampler;
-  const RenderStats stats = render(scene, integrator, options, film);
+  RenderStats stats;
+  const Film film = test::renderFilm(scene, spp, seed, &stats, sampler);
   EXPECT_EQ(stats.nonFinite, 0u);
   return {film.mean(), film.varianceOfMean()};
 }

@@ -14,6 +14,7 @@
 #include "renderer/render.h"
 
 #include <glm/gtc/matrix_transform.hpp>
+#include "test_fixtures.h"
 #include "test_paths.h"
 
 #include <gtest/gtest.h>
@@ -35,17 +36,7 @@ Image renderWith(const Scene& scene, int spp, int threads, uint64_t seed, uint64
   return film.mean();
 }
 
-// Renders with the scene's own image size and depth settings, independent sampler.
-Film renderFilm(const Scene& scene, int spp, uint64_t seed, RenderStats* stats = nullptr) {
-  const PathIntegrator integrator(scene.settings.maxDepth, scene.settings.rrDepth);
-  Film film(scene.settings.width, scene.settings.height);
-  RenderOptions options;
-  options.spp = spp;
-  options.seed = seed;
-  const RenderStats s = render(scene, integrator, options, film);
-  if (stats) *stats = s;
-  return film;
-}
+using test::renderFilm;
 
 // A 10 x 10 quad at y = 0 facing +y: the receiving plane of the analytic lighting tests.
 std::unique_ptr<Shape> floorQuad() {

@@ -1,0 +1,34 @@
+// Small helpers several test files share: a flat shading point and a whole-scene render.
+#pragma once
+
+#include "renderer/path_integrator.h"
+#include "renderer/render.h"
+#include "renderer/scene.h"
+
+namespace ember::test {
+
+// A hit at the origin on the plane z = 0, facing +z, uv (0.5, 0.5): the frame materials are
+// sampled in by the chi-square and furnace tests.
+inline SurfaceHit flatHit() {
+  SurfaceHit hit;
+  hit.p = Vec3(0.0f);
+  hit.ng = hit.ns = Vec3(0.0f, 0.0f, 1.0f);
+  hit.uv = Vec2(0.5f);
+  return hit;
+}
+
+// Renders a built scene at its own image size and depth settings.
+inline Film renderFilm(const Scene& scene, int spp, uint64_t seed, RenderStats* stats = nullptr,
+                       SamplerType sampler = SamplerType::Independent) {
+  const PathIntegrator integrator(scene.settings.maxDepth, scene.settings.rrDepth);
+  Film film(scene.settings.width, scene.settings.height);
+  RenderOptions options;
+  options.spp = spp;
+  options.seed = seed;
+  options.sampler = sampler;
+  const RenderStats s = render(scene, integrator, options, film);
+  if (stats) *stats = s;
+  return film;
+}
+
+}  // namespace ember::test
