@@ -96,7 +96,7 @@ int runBench(const BenchArgs& a) {
     const double buildSeconds = secondsSince(buildStart);
     report["machine"]["isa"] = scene.accel().isaName();
 
-    const PathIntegrator integrator(scene.settings.maxDepth, scene.settings.rrDepth);
+    const PathIntegrator integrator(scene.settings);
     RenderOptions options;
     options.spp = scene.settings.spp;
     options.seed = scene.settings.seed;

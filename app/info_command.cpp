@@ -17,14 +17,18 @@ Runner addInfoCommand(CLI::App& app) {
     const size_t punctualLights = scene.lights.size();  // point, spot, directional: before build() adds more
     scene.build();
     std::map<std::string, int> byType;
-    int emitters = 0;
+    int emitters = 0, twoSidedEmitters = 0;
     for (const auto& s : scene.shapes) {
       ++byType[std::string(s.shape->typeName())];
       emitters += !isBlack(s.emission);
+      twoSidedEmitters += !isBlack(s.emission) && s.twoSidedEmission;
     }
-    size_t emissiveTriangles = 0;
-    for (const auto& m : scene.meshes)
-      if (!isBlack(m.emission)) emissiveTriangles += m.mesh->indices.size();
+    size_t emissiveTriangles = 0, twoSidedTriangles = 0;
+    for (const auto& m : scene.meshes) {
+      if (isBlack(m.emission)) continue;
+      emissiveTriangles += m.mesh->indices.size();
+      if (m.twoSidedEmission) twoSidedTriangles += m.mesh->indices.size();
+    }
     const RenderSettings& rs = scene.settings;
     const CameraParams& c = scene.cameraParams;
     const Bounds b = scene.bounds();
@@ -40,8 +44,12 @@ Runner addInfoCommand(CLI::App& app) {
     std::printf("shapes:     %zu", scene.shapes.size());
     for (const auto& [type, n] : byType) std::printf("  %s %d", type.c_str(), n);
     std::printf("\nmeshes:     %zu (%zu triangles)\n", scene.meshes.size(), scene.triangleCount());
-    std::printf("lights:     %zu punctual, %d area, %zu emissive triangles, %s environment\n", punctualLights,
-                emitters, emissiveTriangles, scene.environment() ? "1" : "no");
+    std::printf(
+        "lights:     %zu punctual, %d area (%d two-sided), %zu emissive triangles (%zu two-sided), %s "
+        "environment\n",
+        punctualLights, emitters, twoSidedEmitters, emissiveTriangles, twoSidedTriangles,
+        scene.environment() ? "1" : "no");
+    std::printf("strategy:   %s\n", std::string(strategyName(rs.strategy)).c_str());
     std::printf("materials:  %zu", scene.materials.size());
     for (size_t i = 0; i < scene.materials.size(); ++i)
       std::printf("%s %s (%s)", i ? "," : "", scene.materialNames[i].c_str(),

@@ -30,6 +30,7 @@ struct RenderArgs {
   std::optional<uint64_t> seed;
   uint64_t firstSample = 0;
   std::string sampler;
+  std::string strategy;
   std::string env;
   bool quiet = false;
 };
@@ -91,11 +92,17 @@ int runRender(const RenderArgs& a) {
   if (!a.env.empty()) applyEnvironment(a.env, scene);
   if (a.sampler == "sobol") s.sampler = SamplerType::Sobol;
   if (a.sampler == "independent") s.sampler = SamplerType::Independent;
+  if (!a.strategy.empty()) s.strategy = *parseStrategy(a.strategy);  // CLI11 checked the name
   scene.build();
+  if (s.strategy == Strategy::Bsdf && scene.lightSampler().deltaLightCount() > 0)
+    std::fprintf(stderr,
+                 "ember: warning: --strategy bsdf cannot reach the scene's %zu point, spot or directional "
+                 "light(s); they contribute nothing\n",
+                 scene.lightSampler().deltaLightCount());
   const double loadSeconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - loadStart).count();
 
-  const PathIntegrator integrator(s.maxDepth, s.rrDepth);
+  const PathIntegrator integrator(s);
   Film film(s.width, s.height);
   RenderOptions options;
   options.spp = s.spp;
@@ -111,6 +118,7 @@ int runRender(const RenderArgs& a) {
                       {"ember:spp", std::to_string(s.spp)},
                       {"ember:seed", std::to_string(s.seed)},
                       {"ember:sampler", s.sampler == SamplerType::Sobol ? "sobol" : "independent"},
+                      {"ember:strategy", std::string(strategyName(s.strategy))},
                       {"ember:first_sample", std::to_string(a.firstSample)},
                       {"ember:render_seconds", std::to_string(stats.seconds)},
                       {"ember:version", EMBER_VERSION},
@@ -165,6 +173,13 @@ Runner addRenderCommand(CLI::App& app) {
                   "Random numbers: sobol (Owen-scrambled, the default) or independent; default: the scene's "
                   "render.sampler")
       ->check(CLI::IsMember({"independent", "sobol"}));
+  cmd->add_option("--strategy", args->strategy,
+                  "Direct-light estimator, all unbiased: mis (light and BSDF sampling with MIS, the default), "
+                  "bsdf (BSDF sampling only: emitters count when paths hit them; point, spot and "
+                  "directional lights are unreachable), light (light sampling at every non-specular "
+                  "vertex; emitters seen by the camera or through mirrors and glass still count); "
+                  "default: the scene's render.strategy")
+      ->check(CLI::IsMember({"mis", "bsdf", "light"}));
   cmd->add_option("--env", args->env,
                   "Environment light: r,g,b (or one number) for a constant colour, or an equirectangular "
                   "EXR/HDR map; replaces the scene's");

@@ -41,10 +41,9 @@ RayBatch makeRays(const Scene& scene, size_t n) {
     const Vec3 dir = Frame(n0).toWorld(sampleCosineHemisphere(Vec2(rng.uniform(), rng.uniform())));
     b.closest.push_back(Ray{offsetRayOrigin(hit.p, hit.ng, dir, hit.t), dir});
     const Vec3 target = lightCenter + Vec3(rng.uniform() - 0.5f, 0.0f, rng.uniform() - 0.5f) * 0.5f;
-    const Vec3 origin = offsetRayOrigin(hit.p, hit.ng, target - hit.p, hit.t);
-    const float dist = glm::length(target - origin);
-    b.shadow.push_back(Ray{origin, (target - origin) / dist});
-    b.shadowDist.push_back(dist * 0.9999f);
+    b.shadow.push_back(spawnRayTo(hit.p, hit.ng, hit.error(), target, Vec3(0.0f, -1.0f, 0.0f),
+                                  roundingErrorBound(maxComponent(glm::abs(target)))));
+    b.shadowDist.push_back(b.shadow.back().tMax);
   }
   return b;
 }
@@ -110,7 +109,7 @@ int run(int argc, char** argv) {
     }
   });
   row("shadow to light, single", [&](size_t lo, size_t hi) {
-    for (size_t i = lo; i < hi; ++i) scene.occluded(b.shadow[i].origin, b.shadow[i].dir, b.shadowDist[i]);
+    for (size_t i = lo; i < hi; ++i) scene.occluded(b.shadow[i]);
   });
   row("incoherent closest-hit, 8-wide", [&](size_t lo, size_t hi) {
     RTCIntersectContext ctx;
@@ -152,7 +151,7 @@ int run(int argc, char** argv) {
     for (size_t i = lo; i < hi; ++i) {
       SurfaceHit h;
       scene.intersect(b.closest[i], h);
-      scene.occluded(b.shadow[i].origin, b.shadow[i].dir, b.shadowDist[i]);
+      scene.occluded(b.shadow[i]);
     }
   });
   std::printf("(vertex mix row: M path vertices/s at the traversal limit)\n");

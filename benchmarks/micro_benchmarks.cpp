@@ -70,7 +70,7 @@ void shapeQuery(benchmark::State& state, bool occlusion) {
   for (auto _ : state) {
     const Ray& r = rays[i++ & 4095];
     if (occlusion) {
-      hits += scene.occluded(r.origin, r.dir, kInfinity);
+      hits += scene.occluded(Ray{r.origin, r.dir, kInfinity});
     } else {
       SurfaceHit hit;
       hits += scene.intersect(r, hit);

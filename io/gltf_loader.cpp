@@ -400,14 +400,14 @@ class GltfImporter {
       if (item.segments.empty()) {
         for (const Vec3& p : item.points)
           scene_.shapes.push_back(
-              {item.where, std::make_unique<Sphere>(p, radius), material, surface.emission});
+              {item.where, std::make_unique<Sphere>(p, radius), material, surface.emission, surface.doubleSided});
         result_.points += item.points.size();
       }
       for (const auto& [a, b] : item.segments) {
         if (item.points[a] == item.points[b]) continue;
         scene_.shapes.push_back({item.where,
                                  std::make_unique<Cylinder>(item.points[a], item.points[b], radius, true),
-                                 material, surface.emission});
+                                 material, surface.emission, surface.doubleSided});
         ++result_.segments;
       }
     }
@@ -496,7 +496,7 @@ class GltfImporter {
       if (it != options_.materialsByName.end()) material = it->second;
     }
     mesh->opacity = surface.opacity;
-    scene_.meshes.push_back({std::move(mesh), material, surface.emission, surface.maps});
+    scene_.meshes.push_back({std::move(mesh), material, surface.emission, surface.maps, surface.doubleSided});
   }
 
   static void appendTriangles(TriangleMesh& mesh, const std::vector<uint32_t>& order, int mode) {

@@ -137,6 +137,9 @@ GltfSurface GltfMaterialReader::convert(int index) {
   out.material = scene_.addMaterial(name, std::make_unique<GltfPbrMaterial>(in));
 
   // Emission: emissiveFactor x KHR_materials_emissive_strength, unscaled (Blender writes both so).
+  // A doubleSided material is lit, and so emits, on its back face too (section 3.9.5: the back
+  // face is shaded with the reversed normal); a single-sided one only on the front.
+  out.doubleSided = m.doubleSided;
   if (!m.emissiveFactor.empty()) {
     if (m.emissiveFactor.size() != 3) fail(where + ".emissiveFactor", "expected 3 numbers");
     out.emission = Color(float(m.emissiveFactor[0]), float(m.emissiveFactor[1]), float(m.emissiveFactor[2]));

@@ -17,6 +17,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 
@@ -84,7 +86,7 @@ class JsonSceneLoader {
   }
 
   void readRender(const JsonNode& n) {
-    n.allowKeys({"spp", "max_depth", "rr_depth", "seed", "background", "sampler"});
+    n.allowKeys({"spp", "max_depth", "rr_depth", "seed", "background", "sampler", "strategy"});
     RenderSettings& s = scene_.settings;
     if (n.has("spp")) s.spp = n.at("spp").integer(1, 1 << 24);
     if (n.has("max_depth")) s.maxDepth = n.at("max_depth").integer(-1, 100000);
@@ -98,6 +100,12 @@ class JsonSceneLoader {
         s.sampler = SamplerType::Independent;
       else
         sampler->fail("unknown sampler '" + v + "'; valid: independent, sobol");
+    }
+    if (auto strategy = n.find("strategy")) {
+      const std::string v = strategy->string();
+      const std::optional<Strategy> parsed = parseStrategy(v);
+      if (!parsed) strategy->fail("unknown strategy '" + v + "'; valid: " + std::string(kStrategyNames));
+      s.strategy = *parsed;
     }
     scene_.background = n.color("background", Color(0.0f));
   }
@@ -259,7 +267,8 @@ class JsonSceneLoader {
     const std::string type = s.at("type").string();
     const Color emission = s.color("emission", Color(0.0f));
     auto common = [&](std::initializer_list<std::string_view> extra) {
-      std::vector<std::string_view> keys{"type", "id", "name", "material", "emission", "flip_normals"};
+      std::vector<std::string_view> keys{"type",     "id",           "name",     "material",
+                                         "emission", "flip_normals", "two_sided"};
       keys.insert(keys.end(), extra.begin(), extra.end());
       checkKeys(s, keys);
     };
@@ -320,8 +329,8 @@ class JsonSceneLoader {
                         "'; valid types are: sphere, disc, cylinder, cone, box, triangle, quad, mesh");
     }
     if (s.boolean("flip_normals", false)) shape = std::make_unique<FlippedShape>(std::move(shape));
-    scene_.shapes.push_back(
-        {shapeName(s, type), std::move(shape), materialFor(s, !isBlack(emission)), emission});
+    scene_.shapes.push_back({shapeName(s, type), std::move(shape), materialFor(s, !isBlack(emission)), emission,
+                             s.boolean("two_sided", false)});
   }
 
   static void checkKeys(const JsonNode& s, const std::vector<std::string_view>& keys) {
@@ -400,6 +409,10 @@ class JsonSceneLoader {
     }
     if (!isBlack(emission))
       for (size_t i = first; i < scene_.meshes.size(); ++i) scene_.meshes[i].emission = emission;
+    if (auto twoSided = s.find("two_sided")) {
+      const bool v = twoSided->boolean();
+      for (size_t i = first; i < scene_.meshes.size(); ++i) scene_.meshes[i].twoSidedEmission = v;
+    }
   }
 
   void readLight(const JsonNode& l) {
@@ -478,9 +491,17 @@ Scene loadGltfScene(const std::string& path, const LoadOptions& load) {
     scene.settings.width = 512;
     scene.cameraParams = framingCamera(bounds, 512.0f / 384.0f);
   }
-  // Without KHR_lights_punctual lights a uniform white environment lights the file like an
-  // overcast sky; with them, the file's own lights alone (`--env` adds an environment).
-  if (imported.lights == 0) scene.background = Color(1.0f);
+  // A file with no light of any kind (no KHR_lights_punctual light, no emissive material) gets a
+  // uniform white environment, like an overcast sky; one with lights is lit by them alone, as
+  // Blender renders it (`--env` adds an environment).
+  const bool emissive =
+      std::any_of(scene.meshes.begin(), scene.meshes.end(), [](const auto& m) { return !isBlack(m.emission); }) ||
+      std::any_of(scene.shapes.begin(), scene.shapes.end(), [](const auto& s) { return !isBlack(s.emission); });
+  if (imported.lights == 0 && !emissive) {
+    scene.background = Color(1.0f);
+    std::fprintf(stderr, "ember: %s has no lights; lighting it with a uniform white environment (--env replaces it)\n",
+                 path.c_str());
+  }
   return scene;
 }
 

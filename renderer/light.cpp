@@ -1,5 +1,6 @@
 #include "renderer/light.h"
 
+#include "renderer/ray_spawn.h"
 #include "renderer/sampling.h"
 
 namespace ember {
@@ -43,6 +44,15 @@ bool SpotLight::sample(const Vec3& ref, Vec2, LightSample& out) const {
   return true;
 }
 
+// The rounding-error bound of points computed from data inside `b` (a sampled point is a sum of
+// terms no larger than the bounds' coordinates).
+static float errorBoundWithin(const Bounds& b) {
+  return roundingErrorBound(std::max(maxComponent(glm::abs(b.lower)), maxComponent(glm::abs(b.upper))));
+}
+
+AreaLight::AreaLight(const Shape* shape, const Color& radiance, bool twoSided)
+    : shape_(shape), radiance_(radiance), twoSided_(twoSided), pError_(errorBoundWithin(shape->bounds())) {}
+
 bool AreaLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
   ShapeSample s;
   float pdf;
@@ -52,11 +62,22 @@ bool AreaLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
   if (out.dist == 0.0f) return false;
   out.wi = d / out.dist;
   out.p = s.p;
+  out.n = s.n;
+  out.pError = pError_;
   out.pdf = pdf;
   out.delta = false;
   // One-sided: the light emits only towards the side its normal faces.
-  out.Li = glm::dot(-out.wi, s.n) > 0.0f ? radiance_ : Color(0.0f);
+  out.Li = twoSided_ || glm::dot(-out.wi, s.n) > 0.0f ? radiance_ : Color(0.0f);
   return true;
+}
+
+TriangleLight::TriangleLight(const TriangleMesh* mesh, uint32_t prim, const Color& radiance,
+                             const Texture* texture, bool twoSided)
+    : mesh_(mesh), prim_(prim), radiance_(radiance), texture_(texture), twoSided_(twoSided) {
+  const glm::uvec3& idx = mesh->indices[prim];
+  Bounds b;
+  for (uint32_t v : {idx.x, idx.y, idx.z}) b.extend(mesh->positions[v]);
+  pError_ = errorBoundWithin(b);
 }
 
 bool TriangleLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
@@ -70,9 +91,11 @@ bool TriangleLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
   if (out.dist == 0.0f) return false;
   out.wi = d / out.dist;
   out.p = p;
+  out.n = surface.ng;
+  out.pError = pError_;
   out.pdf = pdf(ref, p, surface.ng);
   out.delta = false;
-  out.Li = glm::dot(-out.wi, surface.ng) > 0.0f ? radiance_ : Color(0.0f);
+  out.Li = twoSided_ || glm::dot(-out.wi, surface.ng) > 0.0f ? radiance_ : Color(0.0f);
   if (texture_) out.Li *= texture_->eval(surface.uv);
   return out.pdf > 0.0f && std::isfinite(out.pdf);
 }

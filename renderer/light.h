@@ -1,7 +1,8 @@
 // Lights, behind one interface that next-event estimation samples and MIS queries:
 //   PointLight        isotropic radiant intensity I [W/sr per channel]: irradiance I cos / d^2.
-//   AreaLight         a shape with constant one-sided radiance L on the side of its normal.
-//   TriangleLight     one triangle of an emissive mesh (glTF emissiveFactor), sampled by area.
+//   AreaLight         a shape with constant radiance L on the side of its normal, or on both sides.
+//   TriangleLight     one triangle of an emissive mesh (glTF emissiveFactor), sampled by area; both
+//                     sides emit when the glTF material is doubleSided.
 //   EnvironmentLight  constant radiance arriving from every direction (the scene "background").
 #pragma once
 
@@ -17,6 +18,8 @@ namespace ember {
 struct LightSample {
   Vec3 wi;  // unit direction from the reference point towards the light
   Vec3 p;   // the sampled point (unused for infinite lights)
+  Vec3 n{0.0f};        // unit surface normal at p; zero for point and spot lights
+  float pError = 0.0f;  // rounding-error bound of p (renderer/ray_spawn.h); 0 for exact positions
   float dist = kInfinity;
   Color Li{0.0f};    // radiance (or, for delta lights, intensity / d^2) arriving at the ref
   float pdf = 0.0f;  // solid-angle density of wi; 1 for delta lights
@@ -95,25 +98,27 @@ class DirectionalLight final : public Light {
 
 class AreaLight final : public Light {
  public:
-  AreaLight(const Shape* shape, const Color& radiance) : shape_(shape), radiance_(radiance) {}
+  AreaLight(const Shape* shape, const Color& radiance, bool twoSided = false);
   bool sample(const Vec3& ref, Vec2 u, LightSample& out) const override;
   float pdf(const Vec3& ref, const Vec3& p, const Vec3& n) const override {
     return shape_->pdfSolidAngle(ref, p, n);
   }
-  // One-sided Lambertian emitter: Phi = pi * A * L.
-  Color power(float) const override { return kPi * shape_->area() * radiance_; }
+  // Lambertian emitter: Phi = pi * A * L per emitting side.
+  Color power(float) const override { return (twoSided_ ? 2.0f : 1.0f) * kPi * shape_->area() * radiance_; }
+  bool twoSided() const { return twoSided_; }
 
  private:
   const Shape* shape_;
   Color radiance_;
+  bool twoSided_;
+  float pError_;  // rounding-error bound of the shape's sampled points
 };
 
 class TriangleLight final : public Light {
  public:
   // `texture` (optional, borrowed) multiplies the radiance at the surface's UV (glTF emissiveTexture).
   TriangleLight(const TriangleMesh* mesh, uint32_t prim, const Color& radiance,
-                const Texture* texture = nullptr)
-      : mesh_(mesh), prim_(prim), radiance_(radiance), texture_(texture) {}
+                const Texture* texture = nullptr, bool twoSided = false);
   bool sample(const Vec3& ref, Vec2 u, LightSample& out) const override;
   float pdf(const Vec3& ref, const Vec3& p, const Vec3& n) const override {
     return areaToSolidAnglePdf(1.0f / mesh_->triangleArea(prim_), ref, p, n);
@@ -121,14 +126,18 @@ class TriangleLight final : public Light {
   // With a texture, its mean over the whole image stands in for the mean over this triangle: power
   // only steers which light is sampled, so an estimate costs variance, never bias.
   Color power(float) const override {
-    return kPi * mesh_->triangleArea(prim_) * radiance_ * (texture_ ? texture_->average() : Color(1.0f));
+    return (twoSided_ ? 2.0f : 1.0f) * kPi * mesh_->triangleArea(prim_) * radiance_ *
+           (texture_ ? texture_->average() : Color(1.0f));
   }
+  bool twoSided() const { return twoSided_; }
 
  private:
   const TriangleMesh* mesh_;
   uint32_t prim_;
   Color radiance_;
   const Texture* texture_;
+  bool twoSided_;
+  float pError_;  // rounding-error bound of the triangle's sampled points
 };
 
 // Radiance arriving from infinitely far away: a constant colour, or an equirectangular map

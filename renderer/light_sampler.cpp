@@ -12,6 +12,7 @@ LightSampler::LightSampler(const std::vector<Light*>& lights, float sceneRadius)
     if (!(w > 0.0) || !std::isfinite(w)) continue;
     light->samplerIndex = int(lights_.size());
     lights_.push_back(light);
+    deltaLights_ += light->isDelta();
     weights.push_back(w);
     total += w;
   }

@@ -19,8 +19,11 @@ class LightSampler {
   // Picks a light with u in [0, 1); returns nullptr when there is none.
   const Light* sample(float u, float& pmf) const;
   float pmf(const Light* light) const;
+  // Point, spot and directional lights among those that can be chosen.
+  size_t deltaLightCount() const { return deltaLights_; }
 
  private:
+  size_t deltaLights_ = 0;
   std::vector<const Light*> lights_;
   std::vector<float> cdf_;  // cdf_[i] = P(index <= i); cdf_.back() == 1
   std::vector<float> pmf_;

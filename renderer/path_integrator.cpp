@@ -15,18 +15,28 @@ Color PathIntegrator::sampleLight(const Scene& scene, const SurfaceHit& hit, con
   const Color f = hit.material->evalPdf(hit, wo, ls.wi, bsdfPdf);
   if (isBlack(f)) return Color(0.0f);
 
-  const Vec3 origin = offsetRayOrigin(hit.p, hit.ng, ls.wi, hit.t);
-  float dist = kInfinity;
-  if (std::isfinite(ls.dist)) {
-    // Stop short of the light's surface so the light itself does not count as a blocker.
-    dist = glm::length(ls.p - origin) * (1.0f - 1e-4f);
-  }
+  // Lights at a finite distance: a segment between the two points that neither surface blocks.
+  const Ray shadow = std::isfinite(ls.dist)
+                         ? spawnRayTo(hit.p, hit.ng, hit.error(), ls.p, ls.n, ls.pError)
+                         : Ray{offsetRayOrigin(hit.p, hit.ng, ls.wi, hit.t), ls.wi, kInfinity};
   ++stats.shadowRays;
-  if (scene.occluded(origin, ls.wi, dist)) return Color(0.0f);
+  if (scene.occluded(shadow)) return Color(0.0f);
 
   const float lightPdf = pick * ls.pdf;
-  const float weight = ls.delta ? 1.0f : powerHeuristic(lightPdf, bsdfPdf);
+  const float weight = ls.delta || strategy_ == Strategy::Light ? 1.0f : powerHeuristic(lightPdf, bsdfPdf);
   return f * ls.Li * (weight / lightPdf);
+}
+
+float PathIntegrator::emissionWeight(float bsdfPdf, float lightPdf) const {
+  switch (strategy_) {
+    case Strategy::Bsdf:
+      return 1.0f;
+    case Strategy::Light:
+      return lightPdf > 0.0f ? 0.0f : 1.0f;
+    case Strategy::Mis:
+      break;
+  }
+  return powerHeuristic(bsdfPdf, lightPdf);
 }
 
 Color PathIntegrator::Li(const Scene& scene, Ray ray, Sampler& sampler, PathStats& stats) const {
@@ -45,8 +55,7 @@ Color PathIntegrator::Li(const Scene& scene, Ray ray, Sampler& sampler, PathStat
     if (!scene.intersect(ray, hit)) {
       if (const EnvironmentLight* env = scene.environment()) {
         float weight = 1.0f;
-        if (!previousDelta)
-          weight = powerHeuristic(previousPdf, lights.pmf(env) * env->pdfDirection(ray.dir));
+        if (!previousDelta) weight = emissionWeight(previousPdf, lights.pmf(env) * env->pdfDirection(ray.dir));
         radiance += throughput * env->radiance(ray.dir) * weight;
       }
       break;
@@ -61,16 +70,17 @@ Color PathIntegrator::Li(const Scene& scene, Ray ray, Sampler& sampler, PathStat
     const Color emitted = hit.emitted(wo);
     if (!isBlack(emitted)) {
       float weight = 1.0f;
-      if (!previousDelta && hit.light) {
-        const float lightPdf = lights.pmf(hit.light) * hit.light->pdf(previousPoint, hit.p, hit.ng);
-        weight = powerHeuristic(previousPdf, lightPdf);
+      if (!previousDelta) {
+        const float lightPdf =
+            hit.light ? lights.pmf(hit.light) * hit.light->pdf(previousPoint, hit.p, hit.ng) : 0.0f;
+        weight = emissionWeight(previousPdf, lightPdf);
       }
       radiance += throughput * emitted * weight;
     }
 
     if ((maxDepth_ >= 0 && depth >= maxDepth_) || !hit.material) break;
 
-    if (hit.material->hasNonDeltaLobes() && !lights.empty())
+    if (strategy_ != Strategy::Bsdf && hit.material->hasNonDeltaLobes() && !lights.empty())
       radiance += throughput * sampleLight(scene, hit, wo, sampler, stats);
 
     BsdfSample bs;

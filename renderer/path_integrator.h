@@ -11,23 +11,40 @@
 //    the radiance scaling of refraction, so a path inside glass is not killed for it. Unbiased: a
 //    surviving path is reweighted by exactly the inverse of its survival probability.
 // maxDepth counts path segments (the camera ray is segment 1); -1 means unbounded.
+//
+// The strategy (renderer/strategy.h) chooses how direct light is estimated. Each one is a choice of
+// weights w_light + w_bsdf = 1 for every direction either technique can produce (Veach 1997,
+// eq. 9.3), which is what keeps all three unbiased:
+//  - mis:   both techniques, power-heuristic weights;
+//  - bsdf:  w_bsdf = 1: no shadow rays; emitters (and the environment) count when paths hit them.
+//           Delta lights cannot be hit, so they contribute nothing;
+//  - light: w_light = 1 wherever light sampling can produce the direction (light pdf > 0); emission
+//           found by BSDF sampling counts only where it cannot: after a Dirac lobe, from the
+//           camera, or on an emitter the light sampler never picks.
 #pragma once
 
 #include "renderer/integrator.h"
+#include "renderer/strategy.h"
 
 namespace ember {
 
 class PathIntegrator final : public Integrator {
  public:
-  PathIntegrator(int maxDepth, int rrDepth) : maxDepth_(maxDepth), rrDepth_(rrDepth) {}
+  PathIntegrator(int maxDepth, int rrDepth, Strategy strategy = Strategy::Mis)
+      : maxDepth_(maxDepth), rrDepth_(rrDepth), strategy_(strategy) {}
+  explicit PathIntegrator(const RenderSettings& s) : PathIntegrator(s.maxDepth, s.rrDepth, s.strategy) {}
   Color Li(const Scene& scene, Ray ray, Sampler& sampler, PathStats& stats) const override;
 
  private:
   Color sampleLight(const Scene& scene, const SurfaceHit& hit, const Vec3& wo, Sampler& sampler,
                     PathStats& stats) const;
+  // Weight of emission that a BSDF-sampled direction (density bsdfPdf) found, where light sampling
+  // would have produced it with density lightPdf.
+  float emissionWeight(float bsdfPdf, float lightPdf) const;
 
   int maxDepth_;
   int rrDepth_;
+  Strategy strategy_;
 };
 
 }  // namespace ember

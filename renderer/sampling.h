@@ -60,9 +60,12 @@ inline Vec2 sampleUniformTriangle(Vec2 u) {
 
 // Power heuristic with beta = 2 (Veach 1997, eq. 9.13).
 inline float powerHeuristic(float pdfA, float pdfB) {
-  const float a = pdfA * pdfA;
-  const float b = pdfB * pdfB;
-  return a + b > 0.0f ? a / (a + b) : 0.0f;
+  // Written as 1 / (1 + (b/a)^2) so that the huge densities of a light seen from very close or at
+  // grazing (d^2 / cos) cannot overflow the squares into inf / inf.
+  if (!(pdfA > 0.0f)) return 0.0f;
+  if (std::isinf(pdfA)) return std::isinf(pdfB) ? 0.5f : 1.0f;
+  const float r = pdfB / pdfA;
+  return 1.0f / (1.0f + r * r);
 }
 
 }  // namespace ember

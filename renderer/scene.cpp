@@ -21,9 +21,10 @@ void Scene::build() {
 
   for (ShapeEntry& entry : shapes) {
     const uint32_t id = accel_->addShape(entry.shape.get());
-    GeometryRecord rec{entry.shape.get(), nullptr, entry.material, nullptr, entry.emission};
+    GeometryRecord rec{entry.shape.get(), nullptr, entry.material, nullptr, entry.emission,
+                       entry.twoSidedEmission};
     if (!isBlack(entry.emission)) {
-      lights.push_back(std::make_unique<AreaLight>(entry.shape.get(), entry.emission));
+      lights.push_back(std::make_unique<AreaLight>(entry.shape.get(), entry.emission, entry.twoSidedEmission));
       allLights.push_back(lights.back().get());
       rec.light = lights.back().get();
     }
@@ -34,14 +35,16 @@ void Scene::build() {
     if (entry.mesh->indices.empty()) continue;
     const uint32_t id = accel_->addMesh(entry.mesh.get());
     if (records_.size() <= id) records_.resize(id + 1);
-    GeometryRecord rec{nullptr, entry.mesh.get(), entry.material, nullptr, entry.emission, entry.maps.get()};
+    GeometryRecord rec{nullptr,        entry.mesh.get(),       entry.material,  nullptr,
+                       entry.emission, entry.twoSidedEmission, entry.maps.get()};
     if (entry.maps && entry.maps->normalMap && entry.mesh->tangents.empty()) entry.mesh->generateTangents();
     if (!isBlack(entry.emission)) {
       // Every triangle of an emissive mesh is a light of its own, chosen by power like the rest.
       rec.firstTriangleLight = int64_t(triangleLights_.size());
       for (uint32_t prim = 0; prim < entry.mesh->indices.size(); ++prim) {
         lights.push_back(std::make_unique<TriangleLight>(entry.mesh.get(), prim, entry.emission,
-                                                         entry.maps ? entry.maps->emission.get() : nullptr));
+                                                         entry.maps ? entry.maps->emission.get() : nullptr,
+                                                         entry.twoSidedEmission));
         allLights.push_back(lights.back().get());
         triangleLights_.push_back(lights.back().get());
       }
@@ -92,13 +95,14 @@ bool Scene::intersect(const Ray& ray, SurfaceHit& hit) const {
   hit.light =
       rec.firstTriangleLight >= 0 ? triangleLights_[size_t(rec.firstTriangleLight) + raw.primID] : rec.light;
   hit.emission = rec.emission;
+  hit.twoSidedEmission = rec.twoSidedEmission;
   if (rec.maps && rec.maps->emission && !isBlack(rec.emission))
     hit.emission *= rec.maps->emission->eval(hit.uv);
   return true;
 }
 
-bool Scene::occluded(const Vec3& from, const Vec3& dir, float dist) const {
-  return accel_->occluded(Ray{from, dir, dist});
+bool Scene::occluded(const Ray& ray) const {
+  return accel_->occluded(ray);
 }
 
 size_t Scene::triangleCount() const {

@@ -9,6 +9,7 @@
 #include "renderer/light.h"
 #include "renderer/light_sampler.h"
 #include "renderer/sampler.h"
+#include "renderer/strategy.h"
 #include "renderer/surface_hit.h"
 
 #include <memory>
@@ -26,6 +27,7 @@ struct RenderSettings {
   int rrDepth = 5;    // Russian roulette starts after this many segments
   uint64_t seed = 0;
   SamplerType sampler = SamplerType::Sobol;  // docs/performance.md: lower error at equal time
+  Strategy strategy = Strategy::Mis;
 };
 
 class Scene {
@@ -35,12 +37,14 @@ class Scene {
     std::unique_ptr<Shape> shape;
     const Material* material = nullptr;
     Color emission{0.0f};
+    bool twoSidedEmission = false;  // emits on both sides, not only on the side of its normal
   };
   struct MeshEntry {
     std::unique_ptr<TriangleMesh> mesh;
     const Material* material = nullptr;
     Color emission{0.0f};
     std::shared_ptr<const SurfaceMaps> maps;  // normal map, emissive texture; null = none
+    bool twoSidedEmission = false;            // glTF doubleSided: both faces emit
   };
 
   // --- filled in by a loader --------------------------------------------------------------
@@ -64,8 +68,8 @@ class Scene {
   bool built() const { return accel_ != nullptr; }
 
   bool intersect(const Ray& ray, SurfaceHit& hit) const;
-  // True when something blocks the segment from `from` (already offset) to `to`.
-  bool occluded(const Vec3& from, const Vec3& dir, float dist) const;
+  // True when something blocks the ray before ray.tMax (a shadow ray from renderer/ray_spawn.h).
+  bool occluded(const Ray& ray) const;
 
   const Camera& camera() const { return camera_; }
   const LightSampler& lightSampler() const { return lightSampler_; }
@@ -81,6 +85,7 @@ class Scene {
     const Material* material = nullptr;
     const Light* light = nullptr;
     Color emission{0.0f};
+    bool twoSidedEmission = false;
     const SurfaceMaps* maps = nullptr;
     int64_t firstTriangleLight = -1;  // emissive meshes: index of primitive 0's light in triangleLights_
   };

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "renderer/math.h"
+#include "renderer/ray_spawn.h"
 
 #include <cstdint>
 
@@ -19,20 +20,13 @@ struct SurfaceHit {
   const Material* material = nullptr;
   const Light* light = nullptr;  // the area light this surface belongs to, if it emits
   Color emission{0.0f};          // radiance emitted on the side of ng
+  bool twoSidedEmission = false;  // emits on both sides (glTF doubleSided)
 
-  // Radiance the surface emits towards direction w (one-sided: only on the side of ng).
-  Color emitted(const Vec3& w) const { return glm::dot(w, ng) > 0.0f ? emission : Color(0.0f); }
+  // Radiance the surface emits towards direction w: only on the side of ng unless two-sided.
+  Color emitted(const Vec3& w) const {
+    return twoSidedEmission || glm::dot(w, ng) > 0.0f ? emission : Color(0.0f);
+  }
+  float error() const { return hitErrorBound(p, t); }
 };
-
-// Origin for a ray leaving a hit point in direction dir: pushed off the surface along the geometric
-// normal, to the side dir leaves on (Woo et al. 1996). The push is a small multiple of the float
-// rounding error of the hit point, which grows with the magnitude of its coordinates and with the
-// ray distance t it was found at (p = o + t d; PBRT4 section 6.8 derives exact bounds): large
-// enough to escape self-intersection, small enough not to cross a neighbouring face near an acute
-// edge (a cone's rim).
-inline Vec3 offsetRayOrigin(const Vec3& p, const Vec3& ng, const Vec3& dir, float t = 0.0f) {
-  const float eps = 2e-6f * (maxComponent(glm::abs(p)) + std::abs(t)) + 1e-7f;
-  return p + (glm::dot(dir, ng) >= 0.0f ? eps : -eps) * ng;
-}
 
 }  // namespace ember

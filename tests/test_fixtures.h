@@ -20,7 +20,7 @@ inline SurfaceHit flatHit() {
 // Renders a built scene at its own image size and depth settings.
 inline Film renderFilm(const Scene& scene, int spp, uint64_t seed, RenderStats* stats = nullptr,
                        SamplerType sampler = SamplerType::Independent) {
-  const PathIntegrator integrator(scene.settings.maxDepth, scene.settings.rrDepth);
+  const PathIntegrator integrator(scene.settings);
   Film film(scene.settings.width, scene.settings.height);
   RenderOptions options;
   options.spp = spp;

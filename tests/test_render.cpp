@@ -24,7 +24,7 @@ namespace {
 
 Image renderWith(const Scene& scene, int spp, int threads, uint64_t seed, uint64_t first = 0,
                  RenderStats* statsOut = nullptr, const Integrator* integrator = nullptr) {
-  const PathIntegrator path(scene.settings.maxDepth, scene.settings.rrDepth);
+  const PathIntegrator path(scene.settings);
   Film film(scene.settings.width, scene.settings.height);
   RenderOptions options;
   options.spp = spp;
