@@ -173,12 +173,13 @@ Runner addRenderCommand(CLI::App& app) {
                   "Random numbers: sobol (Owen-scrambled, the default) or independent; default: the scene's "
                   "render.sampler")
       ->check(CLI::IsMember({"independent", "sobol"}));
-  cmd->add_option("--strategy", args->strategy,
-                  "Direct-light estimator, all unbiased: mis (light and BSDF sampling with MIS, the default), "
-                  "bsdf (BSDF sampling only: emitters count when paths hit them; point, spot and "
-                  "directional lights are unreachable), light (light sampling at every non-specular "
-                  "vertex; emitters seen by the camera or through mirrors and glass still count); "
-                  "default: the scene's render.strategy")
+  cmd->add_option(
+         "--strategy", args->strategy,
+         "Direct-light estimator, all unbiased: mis (light and BSDF sampling with MIS, the default), "
+         "bsdf (BSDF sampling only: emitters count when paths hit them; point, spot and "
+         "directional lights are unreachable), light (light sampling at every non-specular "
+         "vertex; emitters seen by the camera or through mirrors and glass still count); "
+         "default: the scene's render.strategy")
       ->check(CLI::IsMember({"mis", "bsdf", "light"}));
   cmd->add_option("--env", args->env,
                   "Environment light: r,g,b (or one number) for a constant colour, or an equirectangular "

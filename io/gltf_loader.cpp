@@ -399,8 +399,8 @@ class GltfImporter {
       const Material* material = options_.materialOverride ? options_.materialOverride : surface.material;
       if (item.segments.empty()) {
         for (const Vec3& p : item.points)
-          scene_.shapes.push_back(
-              {item.where, std::make_unique<Sphere>(p, radius), material, surface.emission, surface.doubleSided});
+          scene_.shapes.push_back({item.where, std::make_unique<Sphere>(p, radius), material,
+                                   surface.emission, surface.doubleSided});
         result_.points += item.points.size();
       }
       for (const auto& [a, b] : item.segments) {

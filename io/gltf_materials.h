@@ -16,7 +16,7 @@ namespace ember {
 
 struct GltfSurface {
   const Material* material = nullptr;
-  Color emission{0.0f};  // emissiveFactor x emissiveStrength
+  Color emission{0.0f};      // emissiveFactor x emissiveStrength
   bool doubleSided = false;  // both faces emit (and are shaded with the normal facing the viewer)
   std::shared_ptr<const SurfaceMaps> maps;
   std::shared_ptr<const MeshOpacity> opacity;

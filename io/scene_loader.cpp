@@ -329,8 +329,8 @@ class JsonSceneLoader {
                         "'; valid types are: sphere, disc, cylinder, cone, box, triangle, quad, mesh");
     }
     if (s.boolean("flip_normals", false)) shape = std::make_unique<FlippedShape>(std::move(shape));
-    scene_.shapes.push_back({shapeName(s, type), std::move(shape), materialFor(s, !isBlack(emission)), emission,
-                             s.boolean("two_sided", false)});
+    scene_.shapes.push_back({shapeName(s, type), std::move(shape), materialFor(s, !isBlack(emission)),
+                             emission, s.boolean("two_sided", false)});
   }
 
   static void checkKeys(const JsonNode& s, const std::vector<std::string_view>& keys) {
@@ -494,13 +494,15 @@ Scene loadGltfScene(const std::string& path, const LoadOptions& load) {
   // A file with no light of any kind (no KHR_lights_punctual light, no emissive material) gets a
   // uniform white environment, like an overcast sky; one with lights is lit by them alone, as
   // Blender renders it (`--env` adds an environment).
-  const bool emissive =
-      std::any_of(scene.meshes.begin(), scene.meshes.end(), [](const auto& m) { return !isBlack(m.emission); }) ||
-      std::any_of(scene.shapes.begin(), scene.shapes.end(), [](const auto& s) { return !isBlack(s.emission); });
+  const bool emissive = std::any_of(scene.meshes.begin(), scene.meshes.end(),
+                                    [](const auto& m) { return !isBlack(m.emission); }) ||
+                        std::any_of(scene.shapes.begin(), scene.shapes.end(),
+                                    [](const auto& s) { return !isBlack(s.emission); });
   if (imported.lights == 0 && !emissive) {
     scene.background = Color(1.0f);
-    std::fprintf(stderr, "ember: %s has no lights; lighting it with a uniform white environment (--env replaces it)\n",
-                 path.c_str());
+    std::fprintf(
+        stderr, "ember: %s has no lights; lighting it with a uniform white environment (--env replaces it)\n",
+        path.c_str());
   }
   return scene;
 }

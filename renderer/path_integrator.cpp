@@ -55,7 +55,8 @@ Color PathIntegrator::Li(const Scene& scene, Ray ray, Sampler& sampler, PathStat
     if (!scene.intersect(ray, hit)) {
       if (const EnvironmentLight* env = scene.environment()) {
         float weight = 1.0f;
-        if (!previousDelta) weight = emissionWeight(previousPdf, lights.pmf(env) * env->pdfDirection(ray.dir));
+        if (!previousDelta)
+          weight = emissionWeight(previousPdf, lights.pmf(env) * env->pdfDirection(ray.dir));
         radiance += throughput * env->radiance(ray.dir) * weight;
       }
       break;

@@ -21,10 +21,11 @@ void Scene::build() {
 
   for (ShapeEntry& entry : shapes) {
     const uint32_t id = accel_->addShape(entry.shape.get());
-    GeometryRecord rec{entry.shape.get(), nullptr, entry.material, nullptr, entry.emission,
-                       entry.twoSidedEmission};
+    GeometryRecord rec{entry.shape.get(), nullptr,        entry.material,
+                       nullptr,           entry.emission, entry.twoSidedEmission};
     if (!isBlack(entry.emission)) {
-      lights.push_back(std::make_unique<AreaLight>(entry.shape.get(), entry.emission, entry.twoSidedEmission));
+      lights.push_back(
+          std::make_unique<AreaLight>(entry.shape.get(), entry.emission, entry.twoSidedEmission));
       allLights.push_back(lights.back().get());
       rec.light = lights.back().get();
     }

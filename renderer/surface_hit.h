@@ -18,8 +18,8 @@ struct SurfaceHit {
   Vec2 uv;
   float t = 0.0f;
   const Material* material = nullptr;
-  const Light* light = nullptr;  // the area light this surface belongs to, if it emits
-  Color emission{0.0f};          // radiance emitted on the side of ng
+  const Light* light = nullptr;   // the area light this surface belongs to, if it emits
+  Color emission{0.0f};           // radiance emitted on the side of ng
   bool twoSidedEmission = false;  // emits on both sides (glTF doubleSided)
 
   // Radiance the surface emits towards direction w: only on the side of ng unless two-sided.

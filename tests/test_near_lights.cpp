@@ -48,11 +48,12 @@ Scene ceilingScene() {
   Scene s;
   s.settings.maxDepth = 2;
   const Material* m = s.addMaterial("ceiling", std::make_unique<Lambertian>(grey(kRho)));
-  s.shapes.push_back({"ceiling",
-                      std::make_unique<Quad>(std::array<Vec3, 4>{Vec3(-10, 0, -10), Vec3(10, 0, -10),
-                                                                 Vec3(10, 0, 10), Vec3(-10, 0, 10)},
-                                             std::array<Vec2, 4>{Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)}),
-                      m, Color(0.0f)});
+  s.shapes.push_back(
+      {"ceiling",
+       std::make_unique<Quad>(
+           std::array<Vec3, 4>{Vec3(-10, 0, -10), Vec3(10, 0, -10), Vec3(10, 0, 10), Vec3(-10, 0, 10)},
+           std::array<Vec2, 4>{Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)}),
+       m, Color(0.0f)});
   return s;
 }
 
@@ -74,15 +75,16 @@ void addGltfEmitter(Scene& s, const std::function<void(test::GltfBuilder&, int m
   m.emissiveFactor = {1.0, 1.0, 1.0};
   m.doubleSided = doubleSided;
   if (textured) {  // a 2 x 2 sRGB checker of 255 and 64: linear 1 and ~0.05
-    m.emissiveTexture.index =
-        b.addTexture(2, 2, 3, {255, 255, 255, 64, 64, 64, 64, 64, 64, 255, 255, 255},
-                     TINYGLTF_TEXTURE_WRAP_REPEAT, TINYGLTF_TEXTURE_WRAP_REPEAT, TINYGLTF_TEXTURE_FILTER_NEAREST);
+    m.emissiveTexture.index = b.addTexture(2, 2, 3, {255, 255, 255, 64, 64, 64, 64, 64, 64, 255, 255, 255},
+                                           TINYGLTF_TEXTURE_WRAP_REPEAT, TINYGLTF_TEXTURE_WRAP_REPEAT,
+                                           TINYGLTF_TEXTURE_FILTER_NEAREST);
   }
   build(b, b.addMaterial(m));
   static int counter = 0;
-  const std::string path = (std::filesystem::temp_directory_path() /
-                            ("ember_near_" + std::to_string(::getpid()) + "_" + std::to_string(counter++) + ".gltf"))
-                               .string();
+  const std::string path =
+      (std::filesystem::temp_directory_path() /
+       ("ember_near_" + std::to_string(::getpid()) + "_" + std::to_string(counter++) + ".gltf"))
+          .string();
   ASSERT_TRUE(b.write(path));
   GltfImportOptions options;
   options.transform = transform;
@@ -114,9 +116,9 @@ Estimate pooled(const Film& film) {
 
 // Radiance reflected at the ceiling point `at`, estimated by `strategy` from 64 x 64 pixels x spp
 // paths whose first segment starts `distance` from `at` (below it, at grazing incidence, so that
-// it passes beside the emitters) and hits it: a point probe with no footprint. The hit point's rounding error, and so the offset
-// of the rays leaving it, grows with that distance: 1e-6 is a camera right at the surface, 3 one
-// across the room.
+// it passes beside the emitters) and hits it: a point probe with no footprint. The hit point's rounding
+// error, and so the offset of the rays leaving it, grows with that distance: 1e-6 is a camera right at the
+// surface, 3 one across the room.
 class PointProbe final : public Integrator {
  public:
   PointProbe(const Scene& scene, const Vec3& at, float distance)
@@ -132,7 +134,8 @@ class PointProbe final : public Integrator {
   Ray ray_;
 };
 
-Estimate estimateAt(Scene& scene, Strategy strategy, int spp, float distance = 1e-6f, const Vec3& at = Vec3(0.0f)) {
+Estimate estimateAt(Scene& scene, Strategy strategy, int spp, float distance = 1e-6f,
+                    const Vec3& at = Vec3(0.0f)) {
   scene.settings.width = scene.settings.height = 64;
   scene.settings.strategy = strategy;
   scene.build();
@@ -171,8 +174,7 @@ void expectAllStrategiesMatch(const std::function<Scene()>& make, std::optional<
       EXPECT_NEAR(e.mean, *expected, 5.0 * e.stderr_ + 1e-4 * *expected) << what << ", strategy " << name(s);
     }
     const double precision = s == Strategy::Mis ? 0.003 : s == Strategy::Bsdf ? 0.01 : 0.2;
-    EXPECT_LT(e.stderr_, precision * reference)
-        << what << ", strategy " << name(s) << ": too noisy to tell";
+    EXPECT_LT(e.stderr_, precision * reference) << what << ", strategy " << name(s) << ": too noisy to tell";
     results.emplace_back(s, e);
   }
   for (size_t i = 0; i < results.size(); ++i)
@@ -265,7 +267,8 @@ TEST(NearLights, PolygonsMatchLambertsContourIntegral) {
   const auto uv4 = std::array<Vec2, 4>{Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)};
   const auto uv3 = std::array<Vec2, 3>{Vec2(0, 0), Vec2(1, 0), Vec2(0, 1)};
 
-  for (const auto& [label, quad] : {std::pair{"grazing quad", grazing}, std::pair{"piercing quad", piercing}}) {
+  for (const auto& [label, quad] :
+       {std::pair{"grazing quad", grazing}, std::pair{"piercing quad", piercing}}) {
     // Emitting towards the origin: the normal cross(v1 - v0, v2 - v0) must face it.
     const Vec3 n = glm::cross(quad[1] - quad[0], quad[2] - quad[0]);
     ASSERT_LT(glm::dot(n, quad[0]), 0.0f) << label;
@@ -286,21 +289,27 @@ TEST(NearLights, PolygonsMatchLambertsContourIntegral) {
       },
       kRho / kPi * polygonIrradiance(toDouble({nearTriangle[0], nearTriangle[1], nearTriangle[2]})),
       "near triangle");
-  // The same square as emissive glTF triangles, 0.003 below, single- and double-sided (facing +y).
-  for (const bool doubleSided : {false, true}) {
-    constexpr float h = 0.15f, gap = 0.003f;
-    expectAllStrategiesMatch(
-        [&] {
-          Scene s = ceilingScene();
-          addGltfEmitter(
-              s, [&](test::GltfBuilder& b, int m) { b.addQuad(h, m); }, horizontal(Vec3(0.02f, -gap, 0.0f), 1.0f),
-              doubleSided);
-          return s;
-        },
-        kRho / kPi *
-            polygonIrradiance(toDouble({Vec3(0.02f - h, -gap, -h), Vec3(0.02f + h, -gap, -h),
-                                        Vec3(0.02f + h, -gap, h), Vec3(0.02f - h, -gap, h)})),
-        doubleSided ? "glTF quad, doubleSided" : "glTF quad");
+  // The same square as emissive glTF triangles 0.003 below: facing the ceiling, or facing away
+  // with doubleSided (glTF section 3.9.5: the back face is lit, and emits, as the front).
+  constexpr float h = 0.15f, gap = 0.003f;
+  const double square = kRho / kPi *
+                        polygonIrradiance(toDouble({Vec3(0.02f - h, -gap, -h), Vec3(0.02f + h, -gap, -h),
+                                                    Vec3(0.02f + h, -gap, h), Vec3(0.02f - h, -gap, h)}));
+  const auto glTFSquare = [&](float facingY, bool doubleSided) {
+    return [=] {
+      Scene s = ceilingScene();
+      addGltfEmitter(
+          s, [&](test::GltfBuilder& b, int m) { b.addQuad(h, m); },
+          horizontal(Vec3(0.02f, -gap, 0.0f), facingY), doubleSided);
+      return s;
+    };
+  };
+  expectAllStrategiesMatch(glTFSquare(1.0f, false), square, "glTF quad facing the ceiling");
+  expectAllStrategiesMatch(glTFSquare(-1.0f, true), square, "doubleSided glTF quad facing away");
+  // Single-sided and facing away: no light at all, whichever strategy looks for it.
+  for (Strategy strategy : kStrategies) {
+    Scene s = glTFSquare(-1.0f, false)();
+    EXPECT_EQ(estimateAt(s, strategy, 16).mean, 0.0) << name(strategy);
   }
 }
 
@@ -350,8 +359,8 @@ TEST(NearLights, PointAndSpotLightsMatchTheInverseSquareLaw) {
     expectAllStrategiesMatch(
         [&] {
           Scene s = ceilingScene();
-          s.lights.push_back(std::make_unique<SpotLight>(Vec3(0.0f, -h, 0.0f), Vec3(0, 1, 0), Color(kIntensity),
-                                                         0.3f, 0.5f));
+          s.lights.push_back(std::make_unique<SpotLight>(Vec3(0.0f, -h, 0.0f), Vec3(0, 1, 0),
+                                                         Color(kIntensity), 0.3f, 0.5f));
           return s;
         },
         expected, "spot light " + std::to_string(h), true, 16);
@@ -364,8 +373,8 @@ TEST(NearLights, UniformSkyBehindABlackSphereMatchesTheClosedForm) {
   expectAllStrategiesMatch(
       [&] {
         Scene s = ceilingScene();
-        s.shapes.push_back(
-            {"occluder", std::make_unique<Sphere>(Vec3(0.0f, -float(d), 0.0f), kR), blackMaterial(s), Color(0.0f)});
+        s.shapes.push_back({"occluder", std::make_unique<Sphere>(Vec3(0.0f, -float(d), 0.0f), kR),
+                            blackMaterial(s), Color(0.0f)});
         s.background = Color(1.0f);
         return s;
       },
@@ -396,42 +405,49 @@ std::vector<EmitterCase> emitterCases() {
        [](Scene& s) { addEmitter(s, std::make_unique<Sphere>(Vec3(0.12f, -0.05f, 0.0f), 0.1f)); }},
       {"tilted disc, gap 0.002",
        [](Scene& s) {
-         addEmitter(s, std::make_unique<Disc>(Vec3(0.0f, -0.1f, 0.0f), glm::normalize(Vec3(0.2f, 1.0f, 0.0f)), 0.098f));
+         addEmitter(s, std::make_unique<Disc>(Vec3(0.0f, -0.1f, 0.0f), glm::normalize(Vec3(0.2f, 1.0f, 0.0f)),
+                                              0.098f));
        },
        false, true},
       {"vertical quad beside, grazing",
        [uv4](Scene& s) {
-         addEmitter(s, std::make_unique<Quad>(std::array<Vec3, 4>{Vec3(0.05f, -0.002f, -0.2f), Vec3(0.05f, -0.3f, -0.2f),
-                                                                  Vec3(0.05f, -0.3f, 0.2f), Vec3(0.05f, -0.002f, 0.2f)},
-                                              uv4));
+         addEmitter(s, std::make_unique<Quad>(
+                           std::array<Vec3, 4>{Vec3(0.05f, -0.002f, -0.2f), Vec3(0.05f, -0.3f, -0.2f),
+                                               Vec3(0.05f, -0.3f, 0.2f), Vec3(0.05f, -0.002f, 0.2f)},
+                           uv4));
        }},
       {"two-sided triangle, gap 0.001",
        [uv3](Scene& s) {
          addEmitter(s,
-                    std::make_unique<Triangle>(std::array<Vec3, 3>{Vec3(-0.1f, -0.001f, -0.1f), Vec3(0.15f, -0.001f, 0.0f),
-                                                                   Vec3(-0.05f, -0.004f, 0.12f)},
-                                               uv3),
+                    std::make_unique<Triangle>(
+                        std::array<Vec3, 3>{Vec3(-0.1f, -0.001f, -0.1f), Vec3(0.15f, -0.001f, 0.0f),
+                                            Vec3(-0.05f, -0.004f, 0.12f)},
+                        uv3),
                     true);
        },
        false, true},
       {"horizontal capped cylinder, gap 0.002",
        [](Scene& s) {
-         addEmitter(s, std::make_unique<Cylinder>(Vec3(-0.2f, -0.102f, 0.05f), Vec3(0.2f, -0.102f, -0.05f), 0.1f, true));
+         addEmitter(s, std::make_unique<Cylinder>(Vec3(-0.2f, -0.102f, 0.05f), Vec3(0.2f, -0.102f, -0.05f),
+                                                  0.1f, true));
        },
        false, true},
       {"vertical cylinder below, gap 0.001",
        [](Scene& s) {
-         addEmitter(s, std::make_unique<Cylinder>(Vec3(0.0f, -0.4f, 0.0f), Vec3(0.0f, -0.001f, 0.0f), 0.1f, true));
+         addEmitter(
+             s, std::make_unique<Cylinder>(Vec3(0.0f, -0.4f, 0.0f), Vec3(0.0f, -0.001f, 0.0f), 0.1f, true));
        },
        false, true},
       {"cone, apex 0.001 below",
        [](Scene& s) {
-         addEmitter(s, std::make_unique<Cone>(Vec3(0.05f, -0.2f, 0.0f), Vec3(0.0f, -0.001f, 0.0f), 0.15f, true));
+         addEmitter(s,
+                    std::make_unique<Cone>(Vec3(0.05f, -0.2f, 0.0f), Vec3(0.0f, -0.001f, 0.0f), 0.15f, true));
        },
        false, true},
       {"cone lying on its side, gap 0.003",
        [](Scene& s) {
-         addEmitter(s, std::make_unique<Cone>(Vec3(-0.2f, -0.103f, 0.0f), Vec3(0.2f, -0.003f, 0.0f), 0.1f, true));
+         addEmitter(
+             s, std::make_unique<Cone>(Vec3(-0.2f, -0.103f, 0.0f), Vec3(0.2f, -0.003f, 0.0f), 0.1f, true));
        },
        false, true},
       {"rotated box, gap 0.003",
@@ -451,14 +467,15 @@ std::vector<EmitterCase> emitterCases() {
       {"doubleSided glTF quad, tilted, piercing the ceiling",
        [](Scene& s) {
          const Mat4 t = glm::rotate(horizontal(Vec3(0.0f, -0.02f, 0.0f), 1.0f), 0.3f, Vec3(0, 1, 0));
-         addGltfEmitter(s, [&](test::GltfBuilder& b, int m) { b.addQuad(0.1f, m); }, t, true);
+         addGltfEmitter(
+             s, [&](test::GltfBuilder& b, int m) { b.addQuad(0.1f, m); }, t, true);
        },
        false, true},
       {"textured glTF quad, gap 0.002",
        [](Scene& s) {
          addGltfEmitter(
-             s, [&](test::GltfBuilder& b, int m) { b.addQuad(0.1f, m); }, horizontal(Vec3(0.03f, -0.002f, 0.0f), 1.0f),
-             false, true);
+             s, [&](test::GltfBuilder& b, int m) { b.addQuad(0.1f, m); },
+             horizontal(Vec3(0.03f, -0.002f, 0.0f), 1.0f), false, true);
        },
        false, true},
       {"environment map behind a sphere, gap 0.002",
@@ -468,17 +485,19 @@ std::vector<EmitterCase> emitterCases() {
            for (int x = 4; x < 9; ++x) texels[size_t(y * 32 + x)] = Color(20.0f, 15.0f, 10.0f);  // a low sun
          s.environmentMap = std::make_shared<ImageTexture>(32, 16, std::move(texels), TextureFilter::Bilinear,
                                                            TextureWrap::Repeat, Color(1.0f));
-         s.shapes.push_back(
-             {"occluder", std::make_unique<Sphere>(Vec3(0.08f, -0.052f, 0.0f), 0.05f), blackMaterial(s), Color(0.0f)});
+         s.shapes.push_back({"occluder", std::make_unique<Sphere>(Vec3(0.08f, -0.052f, 0.0f), 0.05f),
+                             blackMaterial(s), Color(0.0f)});
        },
        false, false, 20.0f},
       {"point light 0.002 below",
-       [](Scene& s) { s.lights.push_back(std::make_unique<PointLight>(Vec3(0.01f, -0.002f, 0.0f), Color(0.01f))); },
+       [](Scene& s) {
+         s.lights.push_back(std::make_unique<PointLight>(Vec3(0.01f, -0.002f, 0.0f), Color(0.01f)));
+       },
        true},
       {"spot light 0.002 below, tilted",
        [](Scene& s) {
-         s.lights.push_back(std::make_unique<SpotLight>(Vec3(0.0f, -0.002f, 0.01f), glm::normalize(Vec3(0.0f, 1.0f, -1.0f)),
-                                                        Color(0.01f), 0.4f, 0.9f));
+         s.lights.push_back(std::make_unique<SpotLight>(
+             Vec3(0.0f, -0.002f, 0.01f), glm::normalize(Vec3(0.0f, 1.0f, -1.0f)), Color(0.01f), 0.4f, 0.9f));
        },
        true},
   };
@@ -502,8 +521,8 @@ struct BlockComparison {
   bool passes() const { return failures == 0 && std::abs(meanZ) <= threshold; }
   std::string describe() const {
     char buf[160];
-    std::snprintf(buf, sizeof buf, "%d/%d blocks beyond |z| > %.2f, max |z| %.2f, image-mean z %.2f", failures,
-                  blocks, threshold, maxAbsZ, meanZ);
+    std::snprintf(buf, sizeof buf, "%d/%d blocks beyond |z| > %.2f, max |z| %.2f, image-mean z %.2f",
+                  failures, blocks, threshold, maxAbsZ, meanZ);
     return buf;
   }
 };

@@ -123,6 +123,40 @@ INSTANTIATE_TEST_SUITE_P(SharedScenes, ReferenceImage,
                            return s;
                          });
 
+// The other two estimators of direct light (renderer/strategy.h) are unbiased too, so they must
+// match the same references. BSDF sampling alone cannot reach cornell-point's point light.
+struct StrategyCase {
+  std::string scene;
+  Strategy strategy;
+};
+
+class StrategyReference : public ::testing::TestWithParam<StrategyCase> {};
+
+TEST_P(StrategyReference, MatchesMitsubaWithinNoise) {
+  const auto& [name, strategy] = GetParam();
+  const auto set = [strategy](Scene& s) { s.settings.strategy = strategy; };
+  const Rendered both = average(renderScene(name, 1, kSpp, set), renderScene(name, 2, kSpp, set));
+  const Reference ref = loadReference(name);
+  const BlockZTestResult r = blockZTest(both.mean, both.variance, ref.mean, ref.variance, kBlock, kAlpha);
+  const std::string label = name + ", " + std::string(strategyName(strategy));
+  EXPECT_TRUE(r.passes()) << label << " vs reference: " << describe(r);
+  std::printf("[ %s ] %s\n", label.c_str(), describe(r).c_str());
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    SharedScenes, StrategyReference,
+    ::testing::Values(StrategyCase{"cornell-area", Strategy::Bsdf},
+                      StrategyCase{"cornell-area", Strategy::Light},
+                      StrategyCase{"cornell-point", Strategy::Light}, StrategyCase{"shapes", Strategy::Bsdf},
+                      StrategyCase{"shapes", Strategy::Light}, StrategyCase{"textured", Strategy::Bsdf},
+                      StrategyCase{"textured", Strategy::Light}),
+    [](const auto& info) {
+      std::string s = info.param.scene + "_" + std::string(strategyName(info.param.strategy));
+      for (char& c : s)
+        if (c == '-') c = '_';
+      return s;
+    });
+
 // --- the comparison must be able to fail ----------------------------------------------------
 
 BlockZTestResult compareMutated(const std::string& name, const std::function<void(Scene&)>& mutate) {

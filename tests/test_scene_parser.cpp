@@ -144,7 +144,9 @@ TEST(CommandLine, RenderWritesExrAndPngAndInfoDescribesScene) {
   const auto info = test::runEmber("info '" + scene + "'");
   ASSERT_EQ(info.exitCode, 0) << info.output;
   EXPECT_NE(info.output.find("shapes:     4  disc 1  quad 1  sphere 2"), std::string::npos) << info.output;
-  EXPECT_NE(info.output.find("1 punctual, 1 area (0 two-sided), 0 emissive triangles (0 two-sided)"), std::string::npos) << info.output;
+  EXPECT_NE(info.output.find("1 punctual, 1 area (0 two-sided), 0 emissive triangles (0 two-sided)"),
+            std::string::npos)
+      << info.output;
 
   const auto tm =
       test::runEmber("tonemap '" + dir.file("a.exr") + "' -o '" + dir.file("b.png") + "' --key 0.3");
