@@ -25,12 +25,15 @@ The script writes, under --out:
 - The same scene for Mitsuba 3 (scalar_rgb): an OBJ quad with the same uvs (flip_tex_coords off),
   `normalmap` (flip_invalid_normals and use_shadowing_function off: both are Mitsuba additions
   that glTF does not have) around `diffuse` 0.8, a `bitmap` with raw = true (no sRGB decoding),
-  bilinear, repeat; `path` with max_depth 2 (direct only, as Ember's 2); K seeds give the mean and
-  the per-pixel standard error.
+  format = variant (float32 texels; the default stores a 16-bit file as float16), bilinear,
+  repeat; `path` with max_depth 2 (direct only, as Ember's 2); K seeds give the mean and the
+  per-pixel standard error.
 - An independent numerical reference: the same camera rays, bilinear texel lookup and
   L = (0.8 / pi) E max(0, n . l) per sample, evaluated with numpy (the glTF definition: diffuse_brdf
   = baseColor / pi, the perturbed normal as N, the cosine clamped at 0 as the glTF sample viewer
-  does), with its own per-pixel standard error.
+  does), with its own per-pixel standard error. The same evaluation with the normal first bent
+  as Cycles bends it (ensure_valid_reflection, applied to every closure in Blender 2.8x-3.x) is
+  written as `cycles_like.exr` for illustration; it is not glTF.
 
 It then runs `ember compare` (per-pixel z-test with variance pooling, relMSE) for Ember against
 Mitsuba and against the numerical reference, adds an image-mean z and 8x8 block z-tests, reports
@@ -56,6 +59,7 @@ import OpenEXR
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 ALBEDO = 0.8
 BLACK = 1e-4
+FLOOR = 1e-6
 
 
 # ---------------------------------------------------------------- files
@@ -211,7 +215,10 @@ def render_mitsuba(args, out, png, geo, shadowing=False, name="mitsuba"):
         f.write("vn 0 1 0\n")
         f.write("f 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n")
     bsdf = {"type": "normalmap", "flip_invalid_normals": False, "use_shadowing_function": shadowing,
-            "normalmap": {"type": "bitmap", "filename": png, "raw": True, "filter_type": "bilinear", "wrap_mode": "repeat"},
+            # format "variant": keep float32 texels; "auto" would store a 16-bit file as float16
+            # (bitmap.cpp, 3.9.1), i.e. round the normals to about 5e-4.
+            "normalmap": {"type": "bitmap", "filename": png, "raw": True, "filter_type": "bilinear", "wrap_mode": "repeat",
+                          "format": "variant"},
             "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": [ALBEDO] * 3}}}
     if args.light == "point":
         light = {"type": "point", "position": list(map(float, geo["light_pos"])),
@@ -243,14 +250,40 @@ def render_mitsuba(args, out, png, geo, shadowing=False, name="mitsuba"):
     save_exr(err_path, err)
     print(f"  mitsuba {name}: {args.mi_seeds} seeds x {args.mi_spp} spp, {time.time() - t:.1f} s")
     # The texture Mitsuba actually sampled, against the 16-bit values the script wrote.
-    bmp = np.array(mi.Bitmap(png).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, srgb_gamma=False))
+    # (convert keeps the file's transfer flag, so no decoding happens here either)
+    b = mi.Bitmap(png)
+    bmp = np.array(b.convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, b.srgb_gamma()))
     return exr, err_path, bmp
 
 
 # ---------------------------------------------------------------- numerical glTF reference
 
-def reference(args, tex, geo, spp, seed=7):
-    """Per pixel: mean over spp uniform positions of (0.8/pi) E max(0, n.l), and its stderr."""
+def bend_like_cycles(nx, ny, nz, ix, iy, iz):
+    """Cycles' ensure_valid_(specular_)reflection with Ng = +y (intern/cycles/kernel/closure/
+    bsdf_util.h): tilts N towards Ng just enough that the view ray's mirror reflection about N
+    stays above the surface. Blender 2.8x-3.x applied it to every closure's normal, diffuse
+    included; not part of glTF."""
+    ndi = nx * ix + ny * iy + nz * iz
+    ry = 2 * ndi * ny - iy                           # dot(Ng, R)
+    thr = np.minimum(0.9 * iy, 0.01)
+    Xx, Xz = nx, nz                                   # N minus its Ng component, normalised
+    xl = np.hypot(Xx, Xz)
+    xl = np.where(xl > 0, xl, 1.0)
+    Xx, Xz = Xx / xl, Xz / xl
+    Ix = ix * Xx + iz * Xz
+    a = Ix * Ix + iy * iy
+    b = 2 * (a + iy * thr)
+    c = (thr + iy) ** 2
+    disc = np.sqrt(np.maximum(b * b - 4 * a * c, 0))
+    nz2 = np.where(Ix < 0, 0.25 * (b + disc) / a, 0.25 * (b - disc) / a)
+    bx, by = np.sqrt(np.maximum(1 - nz2, 0)), np.sqrt(np.maximum(nz2, 0))
+    keep = ry >= thr
+    return np.where(keep, nx, bx * Xx), np.where(keep, ny, by), np.where(keep, nz, bx * Xz)
+
+
+def reference(args, tex, geo, spp, seed=7, bend=False):
+    """Per pixel: mean over spp uniform positions of (0.8/pi) E max(0, n.l), and its stderr.
+    bend=True first bends n as Cycles did (bend_like_cycles): an illustration, not glTF."""
     rng = np.random.default_rng(seed)
     W = H = args.size
     t = math.tan(math.radians(geo["fov"]) / 2)
@@ -273,6 +306,9 @@ def reference(args, tex, geo, spp, seed=7):
         n /= np.linalg.norm(n, axis=-1, keepdims=True)
         # world normal = n.x T + n.y B + n.z N with T = +x, B = cross(N, T) = -z, N = +y
         nx, ny, nz = n[..., 0], n[..., 2], -n[..., 1]
+        if bend:
+            vl = np.sqrt(dx * dx + 1 + dz * dz)
+            nx, ny, nz = bend_like_cycles(nx, ny, nz, -dx / vl, 1 / vl, -dz / vl)
         if args.light == "directional":
             lx, ly, lz = geo["to_light"]
             E = args.irradiance
@@ -304,21 +340,22 @@ def compare(args, img, ref, var=None, err=None):
 
 
 def extra_z(img, ref, var, err, block=8):
-    """Image-mean z and block z-tests (mean over block x block pixels and the 3 channels)."""
+    """Image-mean z (per channel; the largest |z| of the three) and block z-tests: the mean
+    difference over each block x block tile of one channel against its standard error, Sidak
+    over all tiles and channels. Channels are tested apart because in a grey scene they carry
+    the same noise."""
+    from statistics import NormalDist
     a, b = load_exr(img), load_exr(ref)
     v = load_exr(var) + load_exr(err) ** 2
-    n = a.size
-    z_mean = (a.mean() - b.mean()) / math.sqrt(v.sum() / n ** 2)
     H, W, _ = a.shape
-    d = (a - b)[: H // block * block, : W // block * block].reshape(H // block, block, W // block, block, 3)
-    vv = v[: H // block * block, : W // block * block].reshape(H // block, block, W // block, block, 3)
-    m = block * block * 3
-    zb = d.sum((1, 3, 4)) / m / np.sqrt(np.maximum(vv.sum((1, 3, 4)), 1e-300) / m ** 2)
-    zb[vv.sum((1, 3, 4)) == 0] = 0.0
+    z_mean = [(a[..., c].mean() - b[..., c].mean()) / math.sqrt(v[..., c].sum() / (H * W) ** 2) for c in range(3)]
+    hb, wb = H // block, W // block
+    d = (a - b)[: hb * block, : wb * block].reshape(hb, block, wb, block, 3).sum((1, 3))
+    s = v[: hb * block, : wb * block].reshape(hb, block, wb, block, 3).sum((1, 3))
+    zb = np.where(s > 0, d / np.sqrt(np.where(s > 0, s, 1.0)), np.where(np.abs(d) > 1e-6, np.inf, 0.0))
     k = zb.size
-    from statistics import NormalDist
     thr = NormalDist().inv_cdf(1 - (1 - (1 - 0.01) ** (1 / k)) / 2)
-    return {"z_mean": float(z_mean), "block_max_abs_z": float(np.abs(zb).max()),
+    return {"z_mean": float(max(z_mean, key=abs)), "block_max_abs_z": float(np.abs(zb).max()),
             "block_rejected": int((np.abs(zb) > thr).sum()), "blocks": int(k), "block_threshold": thr}
 
 
@@ -422,16 +459,23 @@ def main():
     save_exr(r_err, ref_err)
     print(f"  numerical glTF reference: {args.ref_spp} spp, {time.time() - t:.1f} s; "
           f"fraction of the view with n.l <= 0: {frac_neg:.4f}")
+    cyc, cyc_err, _ = reference(args, tex, geo, args.ref_spp, bend=True)
+    c_exr = os.path.join(out, "cycles_like.exr")
+    save_exr(c_exr, cyc)
     controls = {}
     if not args.no_controls:
         for tag in ("flipG", "flipR"):
             controls[tag] = render_ember(args, out, f"ember_{tag}", os.path.join(out, f"scene_{tag}.json"))
 
-    print("\nimage                      mean        black px   lit-side azimuth (light at %.0f deg)" % args.azimuth_deg)
+    flat = load_exr(f_exr).mean(-1)
+    print("\nblack px: max channel < %g; dim px: below 0.1 x the flat-map image" % BLACK)
+    print("image                      mean        black px   dim px    lit-side azimuth (light at %.0f deg)" % args.azimuth_deg)
     for name, path in [("Ember (file tangents)", e_exr), ("Ember (generated tangents)", g_exr), ("Ember (flat map)", f_exr),
-                       ("Mitsuba", m_exr), ("Mitsuba, shadowing term on", ms_exr), ("numerical glTF", r_exr)] + \
+                       ("Mitsuba", m_exr), ("Mitsuba, shadowing term on", ms_exr), ("numerical glTF", r_exr),
+                       ("numerical, Cycles-bent N", c_exr)] + \
                       [(f"Ember {k} (control)", v[0]) for k, v in controls.items()]:
-        print(f"{name:26s} {load_exr(path).mean():.6f}   {black_fraction(path):.4f}     {lit_side(path, args, geo):7.1f}")
+        dim = float(np.mean(load_exr(path).mean(-1) < 0.1 * flat))
+        print(f"{name:26s} {load_exr(path).mean():.6f}   {black_fraction(path):.4f}     {dim:.4f}    {lit_side(path, args, geo):7.1f}")
 
     rows = [("Ember vs Mitsuba", e_exr, m_exr, e_var, m_err),
             ("Ember vs numerical glTF", e_exr, r_exr, e_var, r_err),
@@ -440,7 +484,8 @@ def main():
             ("Mitsuba+shadowing vs numerical glTF*", ms_exr, r_exr, ms_err, r_err)]
     rows += [(f"CONTROL Ember {k} vs Mitsuba", v[0], m_exr, v[1], m_err) for k, v in controls.items()]
     rows += [("CONTROL Ember (flat map) vs Mitsuba", f_exr, m_exr, os.path.join(out, "ember_flat_var.exr"), m_err)]
-    print("\n(* the image's 'variance' there is Mitsuba's stderr squared, written to a temporary EXR)")
+    print(f"\n(* the image's 'variance' there is Mitsuba's stderr squared; every reference stderr has a floor "
+          f"of {FLOOR:g} x |reference| for float rounding in zero-variance pixels)")
     print(f"{'comparison':40s} {'max|z|':>8s} {'rejected':>9s} {'t':>6s} {'mean z':>8s} {'blk max|z|':>10s} {'blk rej':>8s} {'relMSE':>10s}  verdict")
     summary = {}
     for name, img, refp, var, err in rows:
@@ -448,6 +493,12 @@ def main():
             vpath = var.replace("_stderr.exr", "_var.tmp.exr")
             save_exr(vpath, load_exr(var) ** 2)
             var = vpath
+        # Pixels of constant radiance (flat ground under a directional light) have zero variance in
+        # every renderer; a float32 renderer matches there only to rounding, so the reference's
+        # stderr gets a floor of FLOOR x |reference| (far below the noise anywhere else).
+        epath = err.replace(".exr", "_floor.tmp.exr")
+        save_exr(epath, np.sqrt(load_exr(err) ** 2 + (FLOOR * np.abs(load_exr(refp))) ** 2))
+        err = epath
         c = compare(args, img, refp, var, err)
         z = c["ztest"]
         x = extra_z(img, refp, var, err)
@@ -459,11 +510,11 @@ def main():
     with open(os.path.join(out, "summary.json"), "w") as f:
         json.dump(summary, f, indent=1)
 
-    for path in [e_exr, m_exr, r_exr, ms_exr] + [v[0] for v in controls.values()]:
+    for path in [e_exr, m_exr, r_exr, ms_exr, c_exr] + [v[0] for v in controls.values()]:
         subprocess.run([args.ember, "tonemap", path, "-o", path[:-4] + ".png"], check=True, stdout=subprocess.DEVNULL)
-    side = [m_exr, e_exr, r_exr] + ([controls["flipG"][0]] if "flipG" in controls else [])
+    side = [m_exr, e_exr, r_exr, c_exr] + ([controls["flipG"][0]] if "flipG" in controls else [])
     preview(side, os.path.join(out, "side_by_side.png"), scale=np.percentile(load_exr(m_exr), 99.5))
-    print(f"\nPNGs: {out}/side_by_side.png (Mitsuba | Ember | numerical glTF{' | Ember flipG' if controls else ''}), *.png per EXR")
+    print(f"\nPNGs: {out}/side_by_side.png (Mitsuba | Ember | numerical glTF | Cycles-bent N{' | Ember flipG' if controls else ''}), *.png per EXR")
 
 
 if __name__ == "__main__":

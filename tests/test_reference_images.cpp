@@ -130,6 +130,10 @@ struct StrategyCase {
   Strategy strategy;
 };
 
+void PrintTo(const StrategyCase& c, std::ostream* os) {
+  *os << c.scene << ", " << strategyName(c.strategy);
+}
+
 class StrategyReference : public ::testing::TestWithParam<StrategyCase> {};
 
 TEST_P(StrategyReference, MatchesMitsubaWithinNoise) {

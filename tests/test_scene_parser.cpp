@@ -65,7 +65,7 @@ TEST(SceneParser, BadInputNamesFileAndPath) {
        "shapes[3].radius: expected a number > 0"},
       {"unknown shape key", variant("\"radius\": 0.5", "\"radius\": 0.5, \"colour\": 1"),
        "shapes[3].colour: unknown key; valid keys for this shape are: type, id, name, material, emission, "
-       "flip_normals, center, radius"},
+       "flip_normals, two_sided, center, radius"},
       {"unknown top-level key", variant("\"render\"", "\"rendr\""),
        "rendr: unknown key; valid keys here are: image, camera, render"},
       {"unknown material", variant("\"material\": \"white\"}", "\"material\": \"snow\"}"),
