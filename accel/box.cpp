@@ -66,6 +66,23 @@ bool Box::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const
   return true;
 }
 
+SurfacePoint Box::projectToSurface(const Vec3& p, const LocalHit& hit) const {
+  const glm::dmat3 rotation(rotation_);
+  const glm::dvec3 nLocal = glm::transpose(rotation) * glm::dvec3(hit.ng);
+  glm::dvec3 local = glm::transpose(rotation) * (glm::dvec3(p) - glm::dvec3(center_));
+  int axis = 0;
+  for (int i = 1; i < 3; ++i)
+    if (std::abs(nLocal[i]) > std::abs(nLocal[axis])) axis = i;
+  local[axis] = std::copysign(double(half_[axis]), nLocal[axis]);
+  // Off the face's edges, where the neighbouring faces begin.
+  const float margin = edgeMargin(roundedPoint(glm::dvec3(p), 2.0f * maxComponent(half_)));
+  for (int i = 0; i < 3; ++i)
+    if (i != axis && half_[i] > 2.0f * margin)
+      local[i] = std::clamp(local[i], -double(half_[i] - margin), double(half_[i] - margin));
+  // The float rotation is orthonormal to ~1e-7, so the face is known to that fraction of the box.
+  return roundedPoint(glm::dvec3(center_) + rotation * local, 2.0f * maxComponent(half_));
+}
+
 float Box::area() const {
   return 8.0f * (half_.x * half_.y + half_.y * half_.z + half_.z * half_.x);
 }

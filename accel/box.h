@@ -15,6 +15,7 @@ class Box final : public Shape {
   std::string_view typeName() const override { return "box"; }
   Bounds bounds() const override;
   bool intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const override;
+  SurfacePoint projectToSurface(const Vec3& p, const LocalHit& hit) const override;
   float area() const override;
   ShapeSample sampleArea(Vec2 u) const override;
 

@@ -60,6 +60,24 @@ bool Cone::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) cons
   return found;
 }
 
+SurfacePoint Cone::projectToSurface(const Vec3& p, const LocalHit& hit) const {
+  const float margin = capBase_ ? edgeMargin(roundedPoint(glm::dvec3(p), radius_ + height_)) : 0.0f;
+  if (glm::dot(hit.ng, axis_.n) < -0.99f) return cap_.projectToSurface(p, margin);  // the base faces -axis
+  // A cone is ruled: its tangent plane at any lateral point contains the apex. The normal comes
+  // from the float frame, so the surface is known to ~1e-7 of the cone's size.
+  const SurfacePoint onPlane = projectToPlane(p, apex_, hit.ng);
+  const float error = onPlane.error + roundingErrorBound(radius_ + height_);
+  // Off the base's rim: slide along the generator through the point (which lies on the cone)
+  // towards the apex until the point is `margin` above the base.
+  const glm::dvec3 q(onPlane.p), n(axis_.n);
+  const double z = glm::dot(q - glm::dvec3(base_), n);
+  if (z >= double(margin) || height_ <= 2.0f * margin) return {onPlane.p, error};
+  const glm::dvec3 toApex = glm::dvec3(apex_) - q;
+  const double along = glm::dot(toApex, n);  // > 0 below the apex
+  if (!(along > 0.0)) return {onPlane.p, error};
+  return {Vec3(q + (double(margin) - z) / along * toApex), error};
+}
+
 float Cone::area() const {
   const float side = kPi * radius_ * std::sqrt(radius_ * radius_ + height_ * height_);
   return capBase_ ? side + cap_.area() : side;

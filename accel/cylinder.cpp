@@ -57,6 +57,22 @@ bool Cylinder::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) 
   return found;
 }
 
+SurfacePoint Cylinder::projectToSurface(const Vec3& p, const LocalHit& hit) const {
+  // Caps face along the axis, the lateral surface across it.
+  const float along = glm::dot(hit.ng, axis_.n);
+  const float margin = caps_ ? edgeMargin(roundedPoint(glm::dvec3(p), radius_ + height_)) : 0.0f;
+  if (along < -0.5f) return cap0_.projectToSurface(p, margin);
+  if (along > 0.5f) return cap1_.projectToSurface(p, margin);
+  // In the axis frame intersect() uses: x^2 + y^2 = r^2, 0 <= z <= h (kept off the caps' rims).
+  const glm::dvec3 s(axis_.s), t(axis_.t), n(axis_.n), rel = glm::dvec3(p) - glm::dvec3(p0_);
+  const double x = glm::dot(rel, s), y = glm::dot(rel, t), len = std::sqrt(x * x + y * y);
+  if (!(len > 0.0)) return {p, roundingErrorBound(maxComponent(glm::abs(p)) + radius_ + height_)};
+  const double scale = double(radius_) / len;
+  double z = glm::dot(rel, n);
+  if (height_ > 2.0f * margin) z = std::clamp(z, double(margin), double(height_ - margin));
+  return roundedPoint(glm::dvec3(p0_) + scale * x * s + scale * y * t + z * n, radius_ + height_);
+}
+
 float Cylinder::area() const {
   const float side = 2.0f * kPi * radius_ * height_;
   return caps_ ? side + cap0_.area() + cap1_.area() : side;

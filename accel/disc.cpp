@@ -22,6 +22,17 @@ bool DiscGeometry::intersect(const Ray& ray, float tMin, float tMax, LocalHit& h
   return true;
 }
 
+SurfacePoint DiscGeometry::projectToSurface(const Vec3& p, float rimMargin) const {
+  const SurfacePoint onPlane = projectToPlane(p, center, frame.n);
+  if (rimMargin <= 0.0f) return onPlane;
+  const glm::dvec3 rel = glm::dvec3(onPlane.p) - glm::dvec3(center);
+  const glm::dvec3 n(frame.n);
+  const glm::dvec3 radial = rel - glm::dot(rel, n) * n;
+  const double len = glm::length(radial), inner = double(radius) - double(rimMargin);
+  if (!(len > inner) || inner <= 0.0) return onPlane;
+  return {Vec3(glm::dvec3(onPlane.p) - (len - inner) / len * radial), onPlane.error};
+}
+
 ShapeSample DiscGeometry::sampleArea(Vec2 u) const {
   const Vec2 d = radius * sampleUniformDiskConcentric(u);
   return {center + frame.s * d.x + frame.t * d.y, frame.n};

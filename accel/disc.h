@@ -16,6 +16,8 @@ struct DiscGeometry {
   DiscGeometry(const Vec3& c, const Vec3& normal, float r) : center(c), frame(normal), radius(r) {}
   bool intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const;
   ShapeSample sampleArea(Vec2 u) const;
+  // Onto the disc's plane; as a cap, also at least `rimMargin` inside the rim (accel/shape.h).
+  SurfacePoint projectToSurface(const Vec3& p, float rimMargin = 0.0f) const;
   float area() const { return kPi * radius * radius; }
   void extendBounds(Bounds& b) const;
 };
@@ -28,6 +30,9 @@ class Disc final : public Shape {
   Bounds bounds() const override;
   bool intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const override {
     return disc_.intersect(ray, tMin, tMax, hit);
+  }
+  SurfacePoint projectToSurface(const Vec3& p, const LocalHit&) const override {
+    return disc_.projectToSurface(p);
   }
   float area() const override { return disc_.area(); }
   ShapeSample sampleArea(Vec2 u) const override { return disc_.sampleArea(u); }

@@ -19,6 +19,11 @@ class FlippedShape final : public Shape {
     hit.ng = -hit.ng;
     return true;
   }
+  SurfacePoint projectToSurface(const Vec3& p, const LocalHit& hit) const override {
+    LocalHit original = hit;
+    original.ng = -hit.ng;
+    return inner_->projectToSurface(p, original);
+  }
   Vec3 shadingNormal(const Vec3& p, const LocalHit& hit) const override {
     LocalHit original = hit;
     original.ng = -hit.ng;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "renderer/math.h"
+#include "renderer/ray_spawn.h"
 
 #include <string_view>
 
@@ -32,6 +33,12 @@ struct LocalHit {
   Vec2 uv{0.0f};
 };
 
+// A hit point rebuilt on the surface, with the bound of its rounding error (renderer/ray_spawn.h).
+struct SurfacePoint {
+  Vec3 p;
+  float error;
+};
+
 // A point on a shape's surface, chosen by a light-sampling routine.
 struct ShapeSample {
   Vec3 p;
@@ -48,6 +55,17 @@ class Shape {
   // Closest hit with t in (tMin, tMax); false when there is none.
   virtual bool intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const = 0;
 
+  // Moves a hit point p = o + t d, which float rounding of t leaves up to ~ulp(t) off the surface,
+  // onto the surface as intersect() sees it (computed in double from the same float parameters),
+  // so that its error is the rounding of its own coordinates, however far the ray travelled
+  // (PBRT4 section 6.8.5 re-projects sphere hits the same way): rays then leave a surface seen from
+  // afar as closely as one seen from nearby. `hit` is what intersect() reported at p.
+  // Closed shapes with edges (capped cylinders and cones, boxes) also keep the point a few error
+  // bounds away from each edge, on the side of the face that was hit: within rounding of an edge a
+  // point is ambiguous, and a ray offset into the shape from the far side of the edge would start
+  // outside it (a leak through the rim).
+  virtual SurfacePoint projectToSurface(const Vec3& p, const LocalHit& hit) const = 0;
+
   // Shading normal at a hit point; equal to the geometric normal for every shape Ember has.
   virtual Vec3 shadingNormal(const Vec3& /*p*/, const LocalHit& hit) const { return hit.ng; }
 
@@ -62,6 +80,26 @@ class Shape {
   virtual bool sampleSolidAngle(const Vec3& ref, Vec2 u, ShapeSample& s, float& pdf) const;
   virtual float pdfSolidAngle(const Vec3& ref, const Vec3& p, const Vec3& n) const;
 };
+
+// p moved onto the plane through `anchor` with unit normal n (a disc's plane, which its normal
+// defines), or onto the plane through the float vertices a, b, c (a triangle's, which double
+// precision Moller-Trumbore sees exactly), in double precision.
+SurfacePoint projectToPlane(const Vec3& p, const Vec3& anchor, const Vec3& n);
+SurfacePoint projectToPlane(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
+
+// The error bound of a point rounded to float from its double-precision value on a surface:
+// roundingErrorBound of its coordinates, plus that of `size` for shapes whose surface is known
+// only to ~1e-7 of their size (float frames and rotations that are not exactly orthonormal).
+inline SurfacePoint roundedPoint(const glm::dvec3& p, float size = 0.0f) {
+  const Vec3 f(p);
+  return {f, roundingErrorBound(maxComponent(glm::abs(f)) + size)};
+}
+
+// How far a projected point is kept from an edge of its face: after the offset along the normal
+// (one error bound) and rounding (another), it is still on the face's side of the edge.
+inline float edgeMargin(const SurfacePoint& p) {
+  return 4.0f * p.error;
+}
 
 // Converts a density per unit area at p (normal n) into one per unit solid angle seen from ref.
 float areaToSolidAnglePdf(float pdfArea, const Vec3& ref, const Vec3& p, const Vec3& n);

@@ -39,6 +39,12 @@ bool Sphere::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) co
   return true;
 }
 
+SurfacePoint Sphere::projectToSurface(const Vec3& p, const LocalHit&) const {
+  const glm::dvec3 c(center_), rel = glm::dvec3(p) - c;
+  const double len = glm::length(rel);
+  return roundedPoint(len > 0.0 ? c + double(radius_) / len * rel : glm::dvec3(p));
+}
+
 ShapeSample Sphere::sampleArea(Vec2 u) const {
   const Vec3 n = sampleUniformSphere(u);
   return {center_ + radius_ * n, n};

@@ -14,6 +14,7 @@ class Sphere final : public Shape {
   std::string_view typeName() const override { return "sphere"; }
   Bounds bounds() const override;
   bool intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const override;
+  SurfacePoint projectToSurface(const Vec3& p, const LocalHit& hit) const override;
   float area() const override { return 4.0f * kPi * radius_ * radius_; }
   ShapeSample sampleArea(Vec2 u) const override;
   bool sampleSolidAngle(const Vec3& ref, Vec2 u, ShapeSample& s, float& pdf) const override;

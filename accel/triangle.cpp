@@ -105,6 +105,12 @@ bool Quad::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) cons
   return true;
 }
 
+SurfacePoint Quad::projectToSurface(const Vec3& p, const LocalHit&) const {
+  // The diagonal v0-v2 separates the halves: v1 lies on one side of it, v3 on the other.
+  const bool firstHalf = glm::dot(glm::cross(v_[2] - v_[0], p - v_[0]), normal_) <= 0.0f;
+  return firstHalf ? projectToPlane(p, v_[0], v_[1], v_[2]) : projectToPlane(p, v_[0], v_[2], v_[3]);
+}
+
 bool Quad::sampleSolidAngle(const Vec3& ref, Vec2 u, ShapeSample& s, float& pdf) const {
   if (rectangle_ && useSphericalRectangle(ref, 0.5f * (v_[0] + v_[2]), area())) {
     const SphericalRectangle sr(v_[0], v_[1] - v_[0], v_[3] - v_[0], ref);

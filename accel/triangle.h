@@ -23,6 +23,9 @@ class Triangle final : public Shape {
   std::string_view typeName() const override { return "triangle"; }
   Bounds bounds() const override;
   bool intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const override;
+  SurfacePoint projectToSurface(const Vec3& p, const LocalHit&) const override {
+    return projectToPlane(p, v_[0], v_[1], v_[2]);
+  }
   float area() const override { return area_; }
   ShapeSample sampleArea(Vec2 u) const override;
 
@@ -40,6 +43,9 @@ class Quad final : public Shape {
   std::string_view typeName() const override { return "quad"; }
   Bounds bounds() const override;
   bool intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const override;
+  // Onto the plane of the half (v0, v1, v2) or (v0, v2, v3) that p lies over: a quad's four
+  // vertices need only be coplanar to 1e-4 of its size.
+  SurfacePoint projectToSurface(const Vec3& p, const LocalHit& hit) const override;
   float area() const override { return area0_ + area1_; }
   ShapeSample sampleArea(Vec2 u) const override;
   bool sampleSolidAngle(const Vec3& ref, Vec2 u, ShapeSample& s, float& pdf) const override;

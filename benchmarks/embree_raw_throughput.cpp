@@ -39,9 +39,9 @@ RayBatch makeRays(const Scene& scene, size_t n) {
     if (!scene.intersect(cam, hit)) continue;
     const Vec3 n0 = glm::dot(hit.ng, cam.dir) < 0.0f ? hit.ng : -hit.ng;
     const Vec3 dir = Frame(n0).toWorld(sampleCosineHemisphere(Vec2(rng.uniform(), rng.uniform())));
-    b.closest.push_back(Ray{offsetRayOrigin(hit.p, hit.ng, dir, hit.t), dir});
+    b.closest.push_back(Ray{hit.offsetOrigin(dir), dir});
     const Vec3 target = lightCenter + Vec3(rng.uniform() - 0.5f, 0.0f, rng.uniform() - 0.5f) * 0.5f;
-    b.shadow.push_back(spawnRayTo(hit.p, hit.ng, hit.error(), target, Vec3(0.0f, -1.0f, 0.0f),
+    b.shadow.push_back(spawnRayTo(hit.p, hit.ng, hit.pError, target, Vec3(0.0f, -1.0f, 0.0f),
                                   roundingErrorBound(maxComponent(glm::abs(target)))));
     b.shadowDist.push_back(b.shadow.back().tMax);
   }

@@ -16,9 +16,8 @@ Color PathIntegrator::sampleLight(const Scene& scene, const SurfaceHit& hit, con
   if (isBlack(f)) return Color(0.0f);
 
   // Lights at a finite distance: a segment between the two points that neither surface blocks.
-  const Ray shadow = std::isfinite(ls.dist)
-                         ? spawnRayTo(hit.p, hit.ng, hit.error(), ls.p, ls.n, ls.pError)
-                         : Ray{offsetRayOrigin(hit.p, hit.ng, ls.wi, hit.t), ls.wi, kInfinity};
+  const Ray shadow = std::isfinite(ls.dist) ? spawnRayTo(hit.p, hit.ng, hit.pError, ls.p, ls.n, ls.pError)
+                                            : Ray{hit.offsetOrigin(ls.wi), ls.wi, kInfinity};
   ++stats.shadowRays;
   if (scene.occluded(shadow)) return Color(0.0f);
 
@@ -93,7 +92,7 @@ Color PathIntegrator::Li(const Scene& scene, Ray ray, Sampler& sampler, PathStat
     previousPdf = bs.pdf;
     previousPoint = hit.p;
     etaProduct *= bs.eta;
-    ray = Ray{offsetRayOrigin(hit.p, hit.ng, bs.wi, hit.t), bs.wi};
+    ray = Ray{hit.offsetOrigin(bs.wi), bs.wi};
 
     if (depth >= rrDepth_) {
       const float q = std::min(maxComponent(throughput) * etaProduct * etaProduct, 0.95f);

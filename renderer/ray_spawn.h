@@ -16,11 +16,6 @@ inline float roundingErrorBound(float m) {
   return 2e-6f * m + 1e-7f;
 }
 
-// The error bound of a hit point p = o + t d found at ray distance t.
-inline float hitErrorBound(const Vec3& p, float t) {
-  return roundingErrorBound(maxComponent(glm::abs(p)) + std::abs(t));
-}
-
 // `p` pushed along the normal `n` by `error` to the side `dir` points to (Woo et al. 1996): large
 // enough to escape self-intersection, small enough not to cross a neighbouring face near an acute
 // edge (a cone's rim). A zero normal (a point light) leaves p where it is.
@@ -28,9 +23,10 @@ inline Vec3 offsetAlongNormal(const Vec3& p, const Vec3& n, float error, const V
   return p + (glm::dot(dir, n) >= 0.0f ? error : -error) * n;
 }
 
-// Origin for a ray leaving a hit point (found at ray distance t) in direction dir.
-inline Vec3 offsetRayOrigin(const Vec3& p, const Vec3& ng, const Vec3& dir, float t = 0.0f) {
-  return offsetAlongNormal(p, ng, hitErrorBound(p, t), dir);
+// The largest coordinate magnitude within `b`: points computed from data inside it are exact to
+// roundingErrorBound of it.
+inline float magnitudeOf(const Vec3& lower, const Vec3& upper) {
+  return std::max(maxComponent(glm::abs(lower)), maxComponent(glm::abs(upper)));
 }
 
 // A ray along the segment between two points on surfaces, each given with its unit normal (zero

@@ -78,12 +78,25 @@ bool Scene::intersect(const Ray& ray, SurfaceHit& hit) const {
   const GeometryRecord& rec = records_[raw.geomID];
   hit.t = raw.t;
   hit.p = ray.origin + raw.t * ray.dir;
+  // The hit point is rebuilt on the surface itself, so that its rounding error, and with it the
+  // offset of every ray leaving it, depends on the scene's coordinates and not on how far the ray
+  // came (renderer/ray_spawn.h): a shape projects o + t d onto itself, a triangle interpolates its
+  // vertices.
   if (rec.shape) {
     hit.ng = raw.ng;
     hit.uv = raw.uv;
     LocalHit local{raw.t, raw.ng, raw.uv};
+    const SurfacePoint onSurface = rec.shape->projectToSurface(hit.p, local);
+    hit.p = onSurface.p;
+    hit.pError = onSurface.error;
     hit.ns = rec.shape->shadingNormal(hit.p, local);
   } else {
+    const glm::uvec3& idx = rec.mesh->indices[raw.primID];
+    const Vec3 &p0 = rec.mesh->positions[idx.x], &p1 = rec.mesh->positions[idx.y],
+               &p2 = rec.mesh->positions[idx.z];
+    hit.p = (1.0f - raw.uv.x - raw.uv.y) * p0 + raw.uv.x * p1 + raw.uv.y * p2;
+    hit.pError = roundingErrorBound(std::max(
+        maxComponent(glm::abs(p0)), std::max(maxComponent(glm::abs(p1)), maxComponent(glm::abs(p2)))));
     const TriangleMesh::Surface s = rec.mesh->surfaceAt(raw.primID, raw.uv.x, raw.uv.y);
     hit.ng = s.ng;
     hit.uv = s.uv;

@@ -17,6 +17,7 @@ struct SurfaceHit {
   Vec3 ns;  // unit shading normal, in the same hemisphere as ng
   Vec2 uv;
   float t = 0.0f;
+  float pError = roundingErrorBound(0.0f);  // rounding-error bound of p (renderer/ray_spawn.h)
   const Material* material = nullptr;
   const Light* light = nullptr;   // the area light this surface belongs to, if it emits
   Color emission{0.0f};           // radiance emitted on the side of ng
@@ -26,7 +27,8 @@ struct SurfaceHit {
   Color emitted(const Vec3& w) const {
     return twoSidedEmission || glm::dot(w, ng) > 0.0f ? emission : Color(0.0f);
   }
-  float error() const { return hitErrorBound(p, t); }
+  // Origin for a ray leaving the surface in direction dir: p pushed off it by its error bound.
+  Vec3 offsetOrigin(const Vec3& dir) const { return offsetAlongNormal(p, ng, pError, dir); }
 };
 
 }  // namespace ember

@@ -6,7 +6,7 @@
 // the samples equal to the surface's centroid), areas against closed forms, and solid-angle
 // sampling (sphere cone sampling; the quad's solid-angle sampling from far away, which is the
 // area-to-solid-angle conversion; tests/test_chi2.cpp covers the spherical-rectangle case).
-// Through Embree: secondary rays spawned with offsetRayOrigin neither self-intersect (acne) nor
+// Through Embree: secondary rays spawned with SurfaceHit::offsetOrigin neither self-intersect (acne) nor
 // leak through closed shapes.
 //
 // Tolerances: statistical checks allow kSigmas standard errors of the Monte Carlo estimate; exact
@@ -783,7 +783,7 @@ TEST(ShapeQuad, SolidAngleSamplingMatchesIntegratedSolidAngle) {
 
 // ---------------------------------------------------------------------------------------------
 // Robust spawning through Embree: every shape type in one Scene, each with its own material so a
-// hit can be attributed. For random rays hitting each shape, rays spawned with offsetRayOrigin
+// hit can be attributed. For random rays hitting each shape, rays spawned with SurfaceHit::offsetOrigin
 //  (a) reflected to the side the ray came from never hit the same (convex or flat) shape again;
 //  (b) continued straight or refracted into a closed shape hit its far side from inside, and from
 //      there, leave it without hitting it again, or reflect internally without escaping.
@@ -798,7 +798,7 @@ struct SpawnStats {
   }
 };
 
-void runSpawnTest(const Vec3& offset, uint64_t seed) {
+void runSpawnTest(const Vec3& offset, uint64_t seed, float distance = 1.0f) {
   std::vector<ShapeCase> cases = shapeCases(offset);
   Scene scene;
   std::vector<const Material*> mats;
@@ -833,7 +833,7 @@ void runSpawnTest(const Vec3& offset, uint64_t seed) {
       const ShapeSample s = shape.sampleArea(next2(rng));
       const Vec3 side = (sc.flat && rng.uniform() < 0.5f) ? -s.n : s.n;
       const Vec3 w = sampleHemisphere(side, next2(rng));  // includes grazing directions
-      const Vec3 origin = s.p + sc.size * (0.5f + 3.0f * rng.uniform()) * w;
+      const Vec3 origin = s.p + distance * sc.size * (0.5f + 3.0f * rng.uniform()) * w;
       const Vec3 dir = glm::normalize(s.p - origin);
       SurfaceHit h;
       if (!scene.intersect(Ray{origin, dir}, h) || h.material != mine) {
@@ -858,7 +858,7 @@ void runSpawnTest(const Vec3& offset, uint64_t seed) {
       const Vec3 nFacing = fromFront ? h.ng : -h.ng;
       const Vec3 wr = reflect(-dir, nFacing);
       SurfaceHit h2;
-      if (hitsMe(offsetRayOrigin(h.p, h.ng, wr, h.t), wr, h2))
+      if (hitsMe(h.offsetOrigin(wr), wr, h2))
         st.problem("acne: reflected ray re-hit its shape",
                    "at t = " + std::to_string(h2.t) + ", " + where.str());
       if (!sc.closed) continue;
@@ -868,18 +868,18 @@ void runSpawnTest(const Vec3& offset, uint64_t seed) {
       const bool refracted = refract(-dir, h.ng, 1.5f, wt);
       for (const Vec3& win : {dir, refracted ? wt : dir}) {
         SurfaceHit h3;
-        if (!hitsMe(offsetRayOrigin(h.p, h.ng, win, h.t), win, h3) || glm::dot(win, h3.ng) <= 0.0f) {
+        if (!hitsMe(h.offsetOrigin(win), win, h3) || glm::dot(win, h3.ng) <= 0.0f) {
           st.problem("leak: ray into the shape did not hit its far side",
                      "along " + str(win) + ", " + where.str());
           continue;
         }
         SurfaceHit h4;
-        if (hitsMe(offsetRayOrigin(h3.p, h3.ng, win, h3.t), win, h4))
+        if (hitsMe(h3.offsetOrigin(win), win, h4))
           st.problem("acne: ray leaving through the far side re-hit its shape",
                      "leaving at " + str(h3.p) + ", t = " + std::to_string(h4.t) + ", " + where.str());
         const Vec3 wIn = reflect(-win, -h3.ng);
         SurfaceHit h5;
-        if (!hitsMe(offsetRayOrigin(h3.p, h3.ng, wIn, h3.t), wIn, h5) || glm::dot(wIn, h5.ng) <= 0.0f)
+        if (!hitsMe(h3.offsetOrigin(wIn), wIn, h5) || glm::dot(wIn, h5.ng) <= 0.0f)
           st.problem("leak: internal reflection escaped",
                      "reflected at " + str(h3.p) + " ng " + str(h3.ng) + ", " + where.str());
       }
@@ -897,6 +897,13 @@ TEST(SpawnEmbree, NoAcneNoLeaksNearOrigin) {
 // Far from the origin float rounding of hit points grows; the offset scales with |p|.
 TEST(SpawnEmbree, NoAcneNoLeaksFarFromOrigin) {
   runSpawnTest(Vec3(60.0f, -35.0f, 110.0f), 202);
+}
+
+// Hits found by rays from 300 sizes away: o + t d is then far off the surface, and the hit point
+// rebuilt on it (Shape::projectToSurface) must still be close enough for small offsets to work.
+TEST(SpawnEmbree, NoAcneNoLeaksForHitsSeenFromAfar) {
+  runSpawnTest(Vec3(0.0f), 303, 300.0f);
+  runSpawnTest(Vec3(60.0f, -35.0f, 110.0f), 404, 300.0f);
 }
 
 }  // namespace
