@@ -66,6 +66,9 @@ TEST(SceneParser, BadInputNamesFileAndPath) {
       {"unknown shape key", variant("\"radius\": 0.5", "\"radius\": 0.5, \"colour\": 1"),
        "shapes[3].colour: unknown key; valid keys for this shape are: type, id, name, material, emission, "
        "flip_normals, two_sided, center, radius"},
+      {"unknown strategy", variant("\"spp\": 2", "\"spp\": 2, \"strategy\": \"bidir\""),
+       "render.strategy: unknown strategy 'bidir'; valid: mis, bsdf, light"},
+      {"strategy not a string", variant("\"spp\": 2", "\"spp\": 2, \"strategy\": 1"), "render.strategy"},
       {"unknown top-level key", variant("\"render\"", "\"rendr\""),
        "rendr: unknown key; valid keys here are: image, camera, render"},
       {"unknown material", variant("\"material\": \"white\"}", "\"material\": \"snow\"}"),
@@ -166,9 +169,32 @@ TEST(CommandLine, BadArgumentsExitNonZero) {
       test::runEmber("tonemap '" + dir.file("missing.exr") + "' -o '" + dir.file("m.png") + "'").exitCode, 0);
   EXPECT_FALSE(std::filesystem::exists(dir.file("x.exr")));
   EXPECT_FALSE(std::filesystem::exists(dir.file("m.png")));
+  EXPECT_NE(test::runEmber("render '" + scene + "' -o '" + dir.file("x.exr") + "' --strategy bidir").exitCode,
+            0);
+  EXPECT_FALSE(std::filesystem::exists(dir.file("x.exr")));
   const auto help = test::runEmber("render --help");
   EXPECT_EQ(help.exitCode, 0);
   EXPECT_NE(help.output.find("--first-sample"), std::string::npos);
+  EXPECT_NE(help.output.find("--strategy"), std::string::npos);
+}
+
+// --strategy bsdf cannot reach the scene's point light, and says so; the others are silent.
+TEST(CommandLine, BsdfStrategyWarnsAboutUnreachableDeltaLights) {
+  TempDir dir;
+  const std::string scene = dir.write("ok.json", kValidScene);
+  const auto bsdf =
+      test::runEmber("render '" + scene + "' -o '" + dir.file("b.exr") + "' --spp 1 -q --strategy bsdf");
+  ASSERT_EQ(bsdf.exitCode, 0) << bsdf.output;
+  EXPECT_NE(bsdf.output.find("cannot reach the scene's 1 point, spot or directional light"),
+            std::string::npos)
+      << bsdf.output;
+  const auto light =
+      test::runEmber("render '" + scene + "' -o '" + dir.file("l.exr") + "' --spp 1 -q --strategy light");
+  ASSERT_EQ(light.exitCode, 0) << light.output;
+  EXPECT_EQ(light.output.find("warning"), std::string::npos) << light.output;
+  const auto info = test::runEmber(
+      "info '" + dir.write("s.json", variant("\"spp\": 2", "\"spp\": 2, \"strategy\": \"light\"")) + "'");
+  EXPECT_NE(info.output.find("strategy:   light"), std::string::npos) << info.output;
 }
 
 }  // namespace
