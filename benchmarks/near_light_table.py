@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
 """Direct light next to emitters, the measurement of issue 9, as a table: a Lambertian ceiling
 (reflectance 0.5, facing down) and one emitter of radiance 1 below it; a camera with a 0.01 degree
-field of view looks from the side (3 degrees below the ceiling, 2 away) at the ceiling point above
-the emitter, direct light only (max_depth 2). Each case is rendered with every strategy and set
-beside its closed form where there is one: the sphere on its axis (rho (r/d)^2), and quads and
+field of view, 2 away and 15 degrees below the ceiling (on the side away from the flat emitters),
+looks at the ceiling point above the emitter; direct light only (max_depth 2). Each case is
+rendered with every strategy and set beside its closed form where there is one: the sphere on its axis (rho (r/d)^2), and quads and
 discs (as 720-gons) by Lambert's contour integral, E = 1/2 sum Theta_i (n . Gamma_i), clipped to
 the horizon. Without one (the capped cylinder) the bsdf strategy is the unbiased yardstick.
 
@@ -94,7 +94,7 @@ def scene(emitter, spp, strategy):
     emitter = dict(emitter, emission=[1, 1, 1])
     return {
         "image": {"width": 4, "height": 4},
-        "camera": {"origin": [2, -0.105, 0.3], "target": [0, 0, 0], "up": [0, 1, 0], "fov_y_deg": 0.01},
+        "camera": {"origin": [-2, -0.54, 0.3], "target": [0, 0, 0], "up": [0, 1, 0], "fov_y_deg": 0.01},
         "render": render,
         "materials": {"ceiling": {"type": "diffuse", "reflectance": RHO}},
         "shapes": [{"type": "quad", "material": "ceiling",
@@ -102,11 +102,13 @@ def scene(emitter, spp, strategy):
     }
 
 
-def average(path):
-    out = subprocess.run(["oiiotool", path, "--printstats"], capture_output=True, text=True, check=True).stdout
+def average(path, scale=1.0):
+    # oiiotool prints 6 decimals: scale small values up first.
+    args = ["oiiotool", path, "--mulc", repr(scale), "--printstats"]
+    out = subprocess.run(args, capture_output=True, text=True, check=True).stdout
     for line in out.splitlines():
         if "Stats Avg" in line:
-            return float(line.split(":")[1].split()[0])
+            return float(line.split(":")[1].split()[0]) / scale
     raise RuntimeError("no stats for " + path)
 
 
@@ -118,7 +120,7 @@ def measure(ember, emitter, spp, strategy, tmp):
             "--sampler", "independent", "-q"]
     subprocess.run(args, check=True, capture_output=True)
     # Mean of the 16 pixel means, and its standard error from their variances.
-    return average(os.path.join(tmp, "m.exr")), math.sqrt(average(os.path.join(tmp, "v.exr")) / 16)
+    return average(os.path.join(tmp, "m.exr"), 1e3), math.sqrt(average(os.path.join(tmp, "v.exr"), 1e12) / 16)
 
 
 def main():
