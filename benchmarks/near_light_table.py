@@ -3,9 +3,9 @@
 (reflectance 0.5, facing down) and one emitter of radiance 1 below it; a camera with a 0.01 degree
 field of view, 2 away and 15 degrees below the ceiling (on the side away from the flat emitters),
 looks at the ceiling point above the emitter; direct light only (max_depth 2). Each case is
-rendered with every strategy and set beside its closed form where there is one: the sphere on its axis (rho (r/d)^2), and quads and
-discs (as 720-gons) by Lambert's contour integral, E = 1/2 sum Theta_i (n . Gamma_i), clipped to
-the horizon. Without one (the capped cylinder) the bsdf strategy is the unbiased yardstick.
+rendered with every strategy and set beside its closed form where there is one: the sphere on its
+axis (rho (r/d)^2), and quads and discs (as 720-gons) by Lambert's contour integral,
+E = 1/2 sum Theta_i (n . Gamma_i), clipped to the horizon. Without one (the capped cylinder) the bsdf strategy is the unbiased yardstick.
 
     python3 benchmarks/near_light_table.py build/app/ember [--spp 4096] [--old /path/to/old/ember]
 
