@@ -65,7 +65,7 @@ SurfacePoint Cone::projectToSurface(const Vec3& p, const LocalHit& hit) const {
   if (glm::dot(hit.ng, axis_.n) < -0.99f) return cap_.projectToSurface(p, margin);  // the base faces -axis
   // A cone is ruled: its tangent plane at any lateral point contains the apex. The normal comes
   // from the float frame, so the surface is known to ~1e-7 of the cone's size.
-  const SurfacePoint onPlane = projectToPlane(p, apex_, hit.ng);
+  const SurfacePoint onPlane = DoublePlane::through(apex_, hit.ng).project(p);
   const float error = onPlane.error + roundingErrorBound(radius_ + height_);
   // Off the base's rim: slide along the generator through the point (which lies on the cone)
   // towards the apex until the point is `margin` above the base.

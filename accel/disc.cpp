@@ -23,7 +23,7 @@ bool DiscGeometry::intersect(const Ray& ray, float tMin, float tMax, LocalHit& h
 }
 
 SurfacePoint DiscGeometry::projectToSurface(const Vec3& p, float rimMargin) const {
-  const SurfacePoint onPlane = projectToPlane(p, center, frame.n);
+  const SurfacePoint onPlane = plane.project(p);
   if (rimMargin <= 0.0f) return onPlane;
   const glm::dvec3 rel = glm::dvec3(onPlane.p) - glm::dvec3(center);
   const glm::dvec3 n(frame.n);

@@ -13,7 +13,9 @@ struct DiscGeometry {
   Frame frame;  // frame.n is the front normal
   float radius;
 
-  DiscGeometry(const Vec3& c, const Vec3& normal, float r) : center(c), frame(normal), radius(r) {}
+  DoublePlane plane;  // through the centre, with frame.n
+  DiscGeometry(const Vec3& c, const Vec3& normal, float r)
+      : center(c), frame(normal), radius(r), plane(DoublePlane::through(c, normal)) {}
   bool intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const;
   ShapeSample sampleArea(Vec2 u) const;
   // Onto the disc's plane; as a cap, also at least `rimMargin` inside the rim (accel/shape.h).

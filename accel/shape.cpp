@@ -11,17 +11,30 @@ float areaToSolidAnglePdf(float pdfArea, const Vec3& ref, const Vec3& p, const V
   return pdfArea * dist2 / cosLight;
 }
 
-SurfacePoint projectToPlane(const Vec3& p, const Vec3& anchor, const Vec3& n) {
-  const glm::dvec3 dp(p), dn(n);
-  return roundedPoint(dp - glm::dot(dp - glm::dvec3(anchor), dn) / glm::dot(dn, dn) * dn);
+DoublePlane DoublePlane::through(const Vec3& anchor, const Vec3& normal) {
+  DoublePlane plane;
+  const glm::dvec3 n(normal);
+  const double len = glm::length(n);
+  if (!(len > 0.0)) return plane;
+  plane.n = n / len;
+  plane.d = glm::dot(plane.n, glm::dvec3(anchor));
+  return plane;
 }
 
-SurfacePoint projectToPlane(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-  const glm::dvec3 da(a), n = glm::cross(glm::dvec3(b) - da, glm::dvec3(c) - da);
-  const double n2 = glm::dot(n, n);
-  if (!(n2 > 0.0)) return {p, roundingErrorBound(maxComponent(glm::abs(p)))};
+DoublePlane DoublePlane::through(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const glm::dvec3 da(a);
+  const glm::dvec3 n = glm::cross(glm::dvec3(b) - da, glm::dvec3(c) - da);
+  const double len = glm::length(n);
+  DoublePlane plane;
+  if (!(len > 0.0)) return plane;
+  plane.n = n / len;
+  plane.d = glm::dot(plane.n, da);
+  return plane;
+}
+
+SurfacePoint DoublePlane::project(const Vec3& p) const {
   const glm::dvec3 dp(p);
-  return roundedPoint(dp - glm::dot(dp - da, n) / n2 * n);
+  return roundedPoint(dp - (glm::dot(n, dp) - d) * n);
 }
 
 bool Shape::sampleSolidAngle(const Vec3& ref, Vec2 u, ShapeSample& s, float& pdf) const {

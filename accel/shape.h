@@ -81,11 +81,27 @@ class Shape {
   virtual float pdfSolidAngle(const Vec3& ref, const Vec3& p, const Vec3& n) const;
 };
 
-// p moved onto the plane through `anchor` with unit normal n (a disc's plane, which its normal
-// defines), or onto the plane through the float vertices a, b, c (a triangle's, which double
-// precision Moller-Trumbore sees exactly), in double precision.
-SurfacePoint projectToPlane(const Vec3& p, const Vec3& anchor, const Vec3& n);
-SurfacePoint projectToPlane(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
+// A plane dot(n, x) = d in double precision (n of unit length), precomputed so that projecting a
+// hit point onto it costs a dot product: the plane through a disc's centre with its normal (which
+// defines it), or through a triangle's float vertices (which double-precision Moller-Trumbore
+// sees exactly).
+struct DoublePlane {
+  glm::dvec3 n{0.0, 0.0, 1.0};
+  double d = 0.0;
+
+  static DoublePlane through(const Vec3& anchor, const Vec3& normal);
+  static DoublePlane through(const Vec3& a, const Vec3& b, const Vec3& c);
+  SurfacePoint project(const Vec3& p) const;
+  // Whether the ray meets the plane at a t in (tMin, tMax): a cheap first test for flat shapes,
+  // which rejects the many shadow rays that end just short of an emitter on this plane.
+  bool crossedWithin(const Ray& ray, float tMin, float tMax) const {
+    const glm::dvec3 dir(ray.dir);
+    const double denom = glm::dot(n, dir);
+    if (denom == 0.0) return false;
+    const double t = (d - glm::dot(n, glm::dvec3(ray.origin))) / denom;
+    return t > double(tMin) && t < double(tMax);
+  }
+};
 
 // The error bound of a point rounded to float from its double-precision value on a surface:
 // roundingErrorBound of its coordinates, plus that of `size` for shapes whose surface is known

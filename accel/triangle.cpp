@@ -36,7 +36,11 @@ static float triangleArea(const Vec3& v0, const Vec3& v1, const Vec3& v2) {
 }
 
 Triangle::Triangle(const std::array<Vec3, 3>& v, const std::array<Vec2, 3>& uv)
-    : v_(v), uv_(uv), normal_(frontNormal(v[0], v[1], v[2])), area_(triangleArea(v[0], v[1], v[2])) {}
+    : v_(v),
+      uv_(uv),
+      normal_(frontNormal(v[0], v[1], v[2])),
+      plane_(DoublePlane::through(v[0], v[1], v[2])),
+      area_(triangleArea(v[0], v[1], v[2])) {}
 
 Bounds Triangle::bounds() const {
   Bounds b;
@@ -46,7 +50,9 @@ Bounds Triangle::bounds() const {
 
 bool Triangle::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const {
   float t, b1, b2;
-  if (!intersectTriangle(ray, v_[0], v_[1], v_[2], tMin, tMax, t, b1, b2)) return false;
+  if (!plane_.crossedWithin(ray, tMin, tMax) ||
+      !intersectTriangle(ray, v_[0], v_[1], v_[2], tMin, tMax, t, b1, b2))
+    return false;
   hit.t = t;
   hit.ng = normal_;
   hit.uv = (1.0f - b1 - b2) * uv_[0] + b1 * uv_[1] + b2 * uv_[2];
@@ -82,6 +88,7 @@ Quad::Quad(const std::array<Vec3, 4>& v, const std::array<Vec2, 4>& uv)
       v_(v),
       uv_(uv),
       normal_(frontNormal(v[0], v[1], v[2])),
+      planes_{DoublePlane::through(v[0], v[1], v[2]), DoublePlane::through(v[0], v[2], v[3])},
       area0_(triangleArea(v[0], v[1], v[2])),
       area1_(triangleArea(v[0], v[2], v[3])) {}
 
@@ -93,9 +100,11 @@ Bounds Quad::bounds() const {
 
 bool Quad::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const {
   float t, b1, b2;
-  if (intersectTriangle(ray, v_[0], v_[1], v_[2], tMin, tMax, t, b1, b2)) {
+  if (planes_[0].crossedWithin(ray, tMin, tMax) &&
+      intersectTriangle(ray, v_[0], v_[1], v_[2], tMin, tMax, t, b1, b2)) {
     hit.uv = (1.0f - b1 - b2) * uv_[0] + b1 * uv_[1] + b2 * uv_[2];
-  } else if (intersectTriangle(ray, v_[0], v_[2], v_[3], tMin, tMax, t, b1, b2)) {
+  } else if (planes_[1].crossedWithin(ray, tMin, tMax) &&
+             intersectTriangle(ray, v_[0], v_[2], v_[3], tMin, tMax, t, b1, b2)) {
     hit.uv = (1.0f - b1 - b2) * uv_[0] + b1 * uv_[2] + b2 * uv_[3];
   } else {
     return false;
@@ -108,7 +117,7 @@ bool Quad::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) cons
 SurfacePoint Quad::projectToSurface(const Vec3& p, const LocalHit&) const {
   // The diagonal v0-v2 separates the halves: v1 lies on one side of it, v3 on the other.
   const bool firstHalf = glm::dot(glm::cross(v_[2] - v_[0], p - v_[0]), normal_) <= 0.0f;
-  return firstHalf ? projectToPlane(p, v_[0], v_[1], v_[2]) : projectToPlane(p, v_[0], v_[2], v_[3]);
+  return planes_[firstHalf ? 0 : 1].project(p);
 }
 
 bool Quad::sampleSolidAngle(const Vec3& ref, Vec2 u, ShapeSample& s, float& pdf) const {

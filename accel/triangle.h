@@ -23,9 +23,7 @@ class Triangle final : public Shape {
   std::string_view typeName() const override { return "triangle"; }
   Bounds bounds() const override;
   bool intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const override;
-  SurfacePoint projectToSurface(const Vec3& p, const LocalHit&) const override {
-    return projectToPlane(p, v_[0], v_[1], v_[2]);
-  }
+  SurfacePoint projectToSurface(const Vec3& p, const LocalHit&) const override { return plane_.project(p); }
   float area() const override { return area_; }
   ShapeSample sampleArea(Vec2 u) const override;
 
@@ -33,6 +31,7 @@ class Triangle final : public Shape {
   std::array<Vec3, 3> v_;
   std::array<Vec2, 3> uv_;
   Vec3 normal_;
+  DoublePlane plane_;
   float area_;
 };
 
@@ -57,7 +56,8 @@ class Quad final : public Shape {
   std::array<Vec3, 4> v_;
   std::array<Vec2, 4> uv_;
   Vec3 normal_;
-  float area0_, area1_;  // of (v0,v1,v2) and (v0,v2,v3)
+  DoublePlane planes_[2];  // of the halves (v0,v1,v2) and (v0,v2,v3)
+  float area0_, area1_;    // of (v0,v1,v2) and (v0,v2,v3)
 };
 
 }  // namespace ember
