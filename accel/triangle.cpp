@@ -90,7 +90,11 @@ Quad::Quad(const std::array<Vec3, 4>& v, const std::array<Vec2, 4>& uv)
       normal_(frontNormal(v[0], v[1], v[2])),
       planes_{DoublePlane::through(v[0], v[1], v[2]), DoublePlane::through(v[0], v[2], v[3])},
       area0_(triangleArea(v[0], v[1], v[2])),
-      area1_(triangleArea(v[0], v[2], v[3])) {}
+      area1_(triangleArea(v[0], v[2], v[3])) {
+  // A degenerate half (a quad given as a triangle, v3 = v0) has no plane of its own.
+  if (!(area1_ > 0.0f)) planes_[1] = planes_[0];
+  if (!(area0_ > 0.0f)) planes_[0] = planes_[1];
+}
 
 Bounds Quad::bounds() const {
   Bounds b;

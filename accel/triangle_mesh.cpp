@@ -28,6 +28,18 @@ Vec2 TriangleMesh::uvAt(uint32_t prim, float b1, float b2) const {
   return (1.0f - b1 - b2) * uvs[idx.x] + b1 * uvs[idx.y] + b2 * uvs[idx.z];
 }
 
+Vec3 TriangleMesh::pointAt(uint32_t prim, float b1, float b2) const {
+  const glm::uvec3& idx = indices[prim];
+  return (1.0f - b1 - b2) * positions[idx.x] + b1 * positions[idx.y] + b2 * positions[idx.z];
+}
+
+float TriangleMesh::pointError(uint32_t prim) const {
+  const glm::uvec3& idx = indices[prim];
+  float m = 0.0f;
+  for (uint32_t v : {idx.x, idx.y, idx.z}) m = std::max(m, maxComponent(glm::abs(positions[v])));
+  return roundingErrorBound(m);
+}
+
 float TriangleMesh::triangleArea(uint32_t prim) const {
   const glm::uvec3& idx = indices[prim];
   const Vec3& p0 = positions[idx.x];

@@ -17,6 +17,9 @@ class MeshOpacity {
   virtual ~MeshOpacity() = default;
   // `u` is uniform in [0, 1), a hash of the ray and the triangle, for stochastic transparency.
   virtual bool passesThrough(Vec2 uv, float u) const = 0;
+  // The probability that a ray stops at uv: what light sampling weights an emitter's radiance by,
+  // so that it agrees with the emission rays find through passesThrough.
+  virtual float coverage(Vec2 uv) const = 0;
 };
 
 struct TriangleMesh {
@@ -37,6 +40,10 @@ struct TriangleMesh {
   // Surface attributes at barycentrics (b1, b2) of triangle `prim`.
   Surface surfaceAt(uint32_t prim, float b1, float b2) const;
   Vec2 uvAt(uint32_t prim, float b1, float b2) const;
+  // The point at barycentrics (b1, b2) of triangle `prim`, interpolated from its vertices, with the
+  // rounding-error bound of points computed from them (renderer/ray_spawn.h).
+  Vec3 pointAt(uint32_t prim, float b1, float b2) const;
+  float pointError(uint32_t prim) const;
 
   float triangleArea(uint32_t prim) const;
   Bounds bounds() const;

@@ -94,6 +94,8 @@ int runBench(const BenchArgs& a) {
     const auto buildStart = Clock::now();
     scene.build();
     const double buildSeconds = secondsSince(buildStart);
+    if (const std::string w = unreachableLightsWarning(scene, scene.settings.strategy); !w.empty())
+      std::fprintf(stderr, "ember: warning: %s: %s\n", path.c_str(), w.c_str());
     report["machine"]["isa"] = scene.accel().isaName();
 
     const PathIntegrator integrator(scene.settings);

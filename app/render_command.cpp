@@ -82,6 +82,7 @@ int runRender(const RenderArgs& a) {
   const auto loadStart = std::chrono::steady_clock::now();
   LoadOptions loadOptions;
   loadOptions.camera = a.camera;
+  loadOptions.environmentGiven = !a.env.empty();
   Scene scene = loadScene(a.scene, loadOptions);
   RenderSettings& s = scene.settings;
   if (a.spp) s.spp = *a.spp;
@@ -94,11 +95,8 @@ int runRender(const RenderArgs& a) {
   if (a.sampler == "independent") s.sampler = SamplerType::Independent;
   if (!a.strategy.empty()) s.strategy = *parseStrategy(a.strategy);  // CLI11 checked the name
   scene.build();
-  if (s.strategy == Strategy::Bsdf && scene.lightSampler().deltaLightCount() > 0)
-    std::fprintf(stderr,
-                 "ember: warning: --strategy bsdf cannot reach the scene's %zu point, spot or directional "
-                 "light(s); they contribute nothing\n",
-                 scene.lightSampler().deltaLightCount());
+  if (const std::string w = unreachableLightsWarning(scene, s.strategy); !w.empty())
+    std::fprintf(stderr, "ember: warning: %s\n", w.c_str());
   const double loadSeconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - loadStart).count();
 

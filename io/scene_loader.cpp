@@ -498,7 +498,7 @@ Scene loadGltfScene(const std::string& path, const LoadOptions& load) {
                                     [](const auto& m) { return !isBlack(m.emission); }) ||
                         std::any_of(scene.shapes.begin(), scene.shapes.end(),
                                     [](const auto& s) { return !isBlack(s.emission); });
-  if (imported.lights == 0 && !emissive) {
+  if (imported.lights == 0 && !emissive && !load.environmentGiven) {
     scene.background = Color(1.0f);
     std::fprintf(
         stderr, "ember: %s has no lights; lighting it with a uniform white environment (--env replaces it)\n",

@@ -43,6 +43,10 @@ class AlphaOpacity final : public MeshOpacity {
     const float a = alpha_->eval(uv).x;
     return mode_ == AlphaMode::Mask ? a < cutoff_ : u >= a;
   }
+  float coverage(Vec2 uv) const override {
+    const float a = alpha_->eval(uv).x;
+    return mode_ == AlphaMode::Mask ? (a < cutoff_ ? 0.0f : 1.0f) : std::clamp(a, 0.0f, 1.0f);
+  }
 
  private:
   std::shared_ptr<const Texture> alpha_;  // coverage in .x: baseColorFactor.a x texture alpha

@@ -47,7 +47,7 @@ bool SpotLight::sample(const Vec3& ref, Vec2, LightSample& out) const {
 // The rounding-error bound of points computed from data inside `b` (a sampled point is a sum of
 // terms no larger than the bounds' coordinates).
 static float errorBoundWithin(const Bounds& b) {
-  return roundingErrorBound(magnitudeOf(b.lower, b.upper));
+  return roundingErrorBound(std::max(maxComponent(glm::abs(b.lower)), maxComponent(glm::abs(b.upper))));
 }
 
 AreaLight::AreaLight(const Shape* shape, const Color& radiance, bool twoSided)
@@ -73,19 +73,17 @@ bool AreaLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
 
 TriangleLight::TriangleLight(const TriangleMesh* mesh, uint32_t prim, const Color& radiance,
                              const Texture* texture, bool twoSided)
-    : mesh_(mesh), prim_(prim), radiance_(radiance), texture_(texture), twoSided_(twoSided) {
-  const glm::uvec3& idx = mesh->indices[prim];
-  Bounds b;
-  for (uint32_t v : {idx.x, idx.y, idx.z}) b.extend(mesh->positions[v]);
-  pError_ = errorBoundWithin(b);
-}
+    : mesh_(mesh),
+      prim_(prim),
+      radiance_(radiance),
+      texture_(texture),
+      twoSided_(twoSided),
+      pError_(mesh->pointError(prim)) {}
 
 bool TriangleLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
   const Vec2 b = sampleUniformTriangle(u);
   const TriangleMesh::Surface surface = mesh_->surfaceAt(prim_, b.y, 1.0f - b.x - b.y);
-  const glm::uvec3& idx = mesh_->indices[prim_];
-  const Vec3 p = b.x * mesh_->positions[idx.x] + b.y * mesh_->positions[idx.y] +
-                 (1.0f - b.x - b.y) * mesh_->positions[idx.z];
+  const Vec3 p = mesh_->pointAt(prim_, b.y, 1.0f - b.x - b.y);
   const Vec3 d = p - ref;
   out.dist = glm::length(d);
   if (out.dist == 0.0f) return false;
@@ -97,6 +95,8 @@ bool TriangleLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
   out.delta = false;
   out.Li = twoSided_ || glm::dot(-out.wi, surface.ng) > 0.0f ? radiance_ : Color(0.0f);
   if (texture_) out.Li *= texture_->eval(surface.uv);
+  // Cut-out (MASK) or partly transparent (BLEND) parts emit as much as rays that hit them find.
+  if (mesh_->opacity) out.Li *= mesh_->opacity->coverage(surface.uv);
   return out.pdf > 0.0f && std::isfinite(out.pdf);
 }
 

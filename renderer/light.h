@@ -105,7 +105,6 @@ class AreaLight final : public Light {
   }
   // Lambertian emitter: Phi = pi * A * L per emitting side.
   Color power(float) const override { return (twoSided_ ? 2.0f : 1.0f) * kPi * shape_->area() * radiance_; }
-  bool twoSided() const { return twoSided_; }
 
  private:
   const Shape* shape_;
@@ -129,7 +128,6 @@ class TriangleLight final : public Light {
     return (twoSided_ ? 2.0f : 1.0f) * kPi * mesh_->triangleArea(prim_) * radiance_ *
            (texture_ ? texture_->average() : Color(1.0f));
   }
-  bool twoSided() const { return twoSided_; }
 
  private:
   const TriangleMesh* mesh_;

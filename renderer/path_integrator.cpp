@@ -103,4 +103,11 @@ Color PathIntegrator::Li(const Scene& scene, Ray ray, Sampler& sampler, PathStat
   return radiance;
 }
 
+std::string unreachableLightsWarning(const Scene& scene, Strategy strategy) {
+  const size_t delta = scene.lightSampler().deltaLightCount();
+  if (strategy != Strategy::Bsdf || delta == 0) return "";
+  return "strategy bsdf cannot reach the scene's " + std::to_string(delta) +
+         " point, spot or directional light(s); they contribute nothing";
+}
+
 }  // namespace ember

@@ -26,6 +26,8 @@
 #include "renderer/integrator.h"
 #include "renderer/strategy.h"
 
+#include <string>
+
 namespace ember {
 
 class PathIntegrator final : public Integrator {
@@ -46,5 +48,9 @@ class PathIntegrator final : public Integrator {
   int rrDepth_;
   Strategy strategy_;
 };
+
+// The warning to print when `strategy` cannot reach some of a built scene's lights (bsdf and its
+// point, spot and directional lights), or an empty string.
+std::string unreachableLightsWarning(const Scene& scene, Strategy strategy);
 
 }  // namespace ember

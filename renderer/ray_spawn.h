@@ -23,12 +23,6 @@ inline Vec3 offsetAlongNormal(const Vec3& p, const Vec3& n, float error, const V
   return p + (glm::dot(dir, n) >= 0.0f ? error : -error) * n;
 }
 
-// The largest coordinate magnitude within `b`: points computed from data inside it are exact to
-// roundingErrorBound of it.
-inline float magnitudeOf(const Vec3& lower, const Vec3& upper) {
-  return std::max(maxComponent(glm::abs(lower)), maxComponent(glm::abs(upper)));
-}
-
 // A ray along the segment between two points on surfaces, each given with its unit normal (zero
 // for a point light) and its rounding-error bound, for a shadow ray that must report blockers
 // between the two but neither surface itself. Both ends are pushed off their surfaces towards each

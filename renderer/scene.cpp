@@ -98,12 +98,8 @@ bool Scene::intersect(const Ray& ray, SurfaceHit& hit) const {
     }
     hit.ns = rec.shape->shadingNormal(hit.p, local);
   } else {
-    const glm::uvec3& idx = rec.mesh->indices[raw.primID];
-    const Vec3 &p0 = rec.mesh->positions[idx.x], &p1 = rec.mesh->positions[idx.y],
-               &p2 = rec.mesh->positions[idx.z];
-    hit.p = (1.0f - raw.uv.x - raw.uv.y) * p0 + raw.uv.x * p1 + raw.uv.y * p2;
-    hit.pError = roundingErrorBound(std::max(
-        maxComponent(glm::abs(p0)), std::max(maxComponent(glm::abs(p1)), maxComponent(glm::abs(p2)))));
+    hit.p = rec.mesh->pointAt(raw.primID, raw.uv.x, raw.uv.y);
+    hit.pError = rec.mesh->pointError(raw.primID);
     const TriangleMesh::Surface s = rec.mesh->surfaceAt(raw.primID, raw.uv.x, raw.uv.y);
     hit.ng = s.ng;
     hit.uv = s.uv;

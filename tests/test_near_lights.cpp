@@ -67,7 +67,8 @@ void addEmitter(Scene& s, std::unique_ptr<Shape> shape, bool twoSided = false) {
 
 // An emissive glTF mesh (tests/gltf_builder.h) placed by `transform`.
 void addGltfEmitter(Scene& s, const std::function<void(test::GltfBuilder&, int material)>& build,
-                    const Mat4& transform, bool doubleSided, bool textured = false) {
+                    const Mat4& transform, bool doubleSided, bool textured = false,
+                    const std::function<void(test::GltfBuilder&, tinygltf::Material&)>& tweak = {}) {
   test::GltfBuilder b;
   tinygltf::Material m;
   m.name = "glow";
@@ -79,6 +80,7 @@ void addGltfEmitter(Scene& s, const std::function<void(test::GltfBuilder&, int m
                                            TINYGLTF_TEXTURE_WRAP_REPEAT, TINYGLTF_TEXTURE_WRAP_REPEAT,
                                            TINYGLTF_TEXTURE_FILTER_NEAREST);
   }
+  if (tweak) tweak(b, m);
   build(b, b.addMaterial(m));
   static int counter = 0;
   const std::string path =
@@ -475,6 +477,31 @@ std::vector<EmitterCase> emitterCases() {
          addGltfEmitter(
              s, [&](test::GltfBuilder& b, int m) { b.addQuad(0.1f, m); },
              horizontal(Vec3(0.03f, -0.002f, 0.0f), 1.0f), false, true);
+       },
+       false, true},
+      {"alpha-masked glTF quad (cut-out checker), gap 0.002",
+       [](Scene& s) {
+         addGltfEmitter(
+             s, [&](test::GltfBuilder& b, int m) { b.addQuad(0.1f, m); },
+             horizontal(Vec3(0.02f, -0.002f, 0.0f), 1.0f), false, false,
+             [](test::GltfBuilder& b, tinygltf::Material& m) {
+               m.alphaMode = "MASK";
+               m.pbrMetallicRoughness.baseColorTexture.index =
+                   b.addTexture(2, 2, 4, {0, 0, 0, 255, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 255},
+                                TINYGLTF_TEXTURE_WRAP_REPEAT, TINYGLTF_TEXTURE_WRAP_REPEAT,
+                                TINYGLTF_TEXTURE_FILTER_NEAREST);
+             });
+       },
+       false, true},
+      {"alpha-blended glTF quad (alpha 0.4), gap 0.002",
+       [](Scene& s) {
+         addGltfEmitter(
+             s, [&](test::GltfBuilder& b, int m) { b.addQuad(0.1f, m); },
+             horizontal(Vec3(0.02f, -0.002f, 0.0f), 1.0f), true, false,
+             [](test::GltfBuilder&, tinygltf::Material& m) {
+               m.alphaMode = "BLEND";
+               m.pbrMetallicRoughness.baseColorFactor = {0.0, 0.0, 0.0, 0.4};
+             });
        },
        false, true},
       {"environment map behind a sphere, gap 0.002",

@@ -890,6 +890,64 @@ void runSpawnTest(const Vec3& offset, uint64_t seed, float distance = 1.0f) {
   }
 }
 
+// Shadow rays to every shape as an emitter (renderer/ray_spawn.h spawnRayTo): from points in front
+// of a sampled point, at 1e-3 to 3 sizes and down to grazing angles, on a receiver whose normal
+// faces the light and whose origin offset is that of a hit seen from one size away (and which is
+// farther from the emitter than that offset and the light sample's error together), a ray to a
+// light sample that faces the receiver (so is visible: every shape here is convex or flat) must
+// never be blocked by the emitter itself. The shadow ray before issue 9, which kept the direction
+// from the un-offset point and stopped a relative 1e-4 short, must fail somewhere, or the check
+// could not tell.
+int runShadowRayTest(const Vec3& offset, uint64_t seed) {
+  int oldStyleBlocked = 0;
+  for (const ShapeCase& sc : shapeCases(offset)) {
+    Scene scene;
+    scene.shapes.push_back(Scene::ShapeEntry{sc.name, sc.make(), nullptr, Color(1.0f)});
+    scene.build();
+    EXPECT_FALSE(scene.lightSampler().empty());
+    if (scene.lightSampler().empty()) continue;
+    float pick;
+    const Light* light = scene.lightSampler().sample(0.5f, pick);
+    const Shape& shape = *scene.shapes[0].shape;
+    SCOPED_TRACE(sc.name + " at offset " + str(offset));
+    Rng rng(seed, 7);
+    int tried = 0, blocked = 0, oldBlocked = 0;
+    std::string example;
+    for (int k = 0; k < 6000; ++k) {
+      const ShapeSample s = shape.sampleArea(next2(rng));
+      const Vec3 w = sampleHemisphere(s.n, next2(rng));
+      const float dist = sc.size * std::pow(10.0f, -3.0f + 3.5f * rng.uniform());
+      const Vec3 ref = s.p + dist * w;
+      // The receiver faces the light: its normal within 60 degrees of the way back to s.
+      const Vec3 nFrom = glm::normalize(-w + 0.5f * sampleUniformSphere(next2(rng)));
+      const float errFrom = roundingErrorBound(maxComponent(glm::abs(ref)) + sc.size);
+      LightSample ls;
+      if (!light->sample(ref, next2(rng), ls) || isBlack(ls.Li) || glm::dot(nFrom, ls.wi) <= 0.0f) continue;
+      // The emitter lies behind its tangent plane at s, so ref is at least this far from it; a
+      // receiver nearer than its own rounding error (plus the light's) cannot be told apart from
+      // one touching the emitter.
+      if (dist * glm::dot(w, s.n) < 4.0f * (errFrom + ls.pError)) continue;
+      ++tried;
+      if (scene.occluded(spawnRayTo(ref, nFrom, errFrom, ls.p, ls.n, ls.pError))) {
+        if (blocked++ == 0) example = "from " + str(ref) + " to " + str(ls.p) + " n " + str(ls.n);
+      }
+      const Vec3 origin = offsetAlongNormal(ref, nFrom, errFrom, ls.wi);
+      oldBlocked += scene.occluded(Ray{origin, ls.wi, glm::length(ls.p - origin) * (1.0f - 1e-4f)});
+    }
+    EXPECT_GT(tried, 400);
+    EXPECT_EQ(blocked, 0) << "of " << tried << " shadow rays; first " << example;
+    std::printf("[ %s ] %d shadow rays, blocked by their own emitter: %d now, %d as before issue 9\n",
+                sc.name.c_str(), tried, blocked, oldBlocked);
+    oldStyleBlocked += oldBlocked;
+  }
+  return oldStyleBlocked;
+}
+
+TEST(SpawnEmbree, ShadowRaysNeverHitTheirOwnEmitter) {
+  const int before = runShadowRayTest(Vec3(0.0f), 505) + runShadowRayTest(Vec3(60.0f, -35.0f, 110.0f), 606);
+  EXPECT_GT(before, 0) << "the shadow ray before issue 9 must fail this test somewhere";
+}
+
 TEST(SpawnEmbree, NoAcneNoLeaksNearOrigin) {
   runSpawnTest(Vec3(0.0f), 101);
 }
