@@ -18,19 +18,11 @@ import tempfile
 import time
 
 import numpy as np
-import OpenEXR
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
-
-
-def load_exr(path):
-    with OpenEXR.File(path) as f:
-        ch = f.channels()
-        if "RGB" in ch:
-            return np.array(ch["RGB"].pixels, dtype=np.float64)
-        return np.stack([np.array(ch[c].pixels, dtype=np.float64) for c in "RGB"], -1)
+from exr import load_exr  # noqa: E402
 
 
 def relmse(img, ref):

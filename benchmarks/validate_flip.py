@@ -16,28 +16,16 @@ import tempfile
 
 import flip_evaluator as flip
 import numpy as np
-import OpenEXR
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from exr import load_exr, save_exr  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
-def load(path):
-    with OpenEXR.File(path) as f:
-        ch = f.channels()
-        if "RGB" in ch:
-            return np.array(ch["RGB"].pixels, dtype=np.float64)
-        return np.stack([np.array(ch[c].pixels, dtype=np.float64) for c in "RGB"], -1)
-
-
-def save(path, img):
-    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
-    with OpenEXR.File(header, {"RGB": img.astype(np.float32)}) as f:
-        f.write(path)
-
-
 def main():
-    ref = load(os.path.join(ROOT, "tests", "data", "cornell-area", "reference.exr"))
-    test = load(sys.argv[1])
+    ref = load_exr(os.path.join(ROOT, "tests", "data", "cornell-area", "reference.exr"))
+    test = load_exr(sys.argv[1])
     lum = lambda c: 0.2126 * c[..., 0] + 0.7152 * c[..., 1] + 0.0722 * c[..., 2]
     L = lum(ref)
     logavg, white = np.exp(np.mean(np.log(1e-6 + np.maximum(L, 0)))), L.max()
@@ -59,8 +47,8 @@ def main():
     }
     tmp = tempfile.mkdtemp()
     for name, (a, b) in pairs.items():
-        save(os.path.join(tmp, "a.exr"), a)
-        save(os.path.join(tmp, "b.exr"), b)
+        save_exr(os.path.join(tmp, "a.exr"), a)
+        save_exr(os.path.join(tmp, "b.exr"), b)
         _, official, _ = flip.evaluate(a.astype(np.float32), b.astype(np.float32), "LDR", inputsRGB=False, applyMagma=False)
         out = subprocess.run([os.path.join(ROOT, "build", "app", "ember"), "compare", os.path.join(tmp, "b.exr"),
                               os.path.join(tmp, "a.exr"), "--ldr", "--json"], capture_output=True, text=True).stdout

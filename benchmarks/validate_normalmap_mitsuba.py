@@ -54,7 +54,9 @@ import time
 import zlib
 
 import numpy as np
-import OpenEXR
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from exr import load_exr, save_exr  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 ALBEDO = 0.8
@@ -83,20 +85,6 @@ def write_png(path, img, bits):
         f.write(chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, bits, 2, 0, 0, 0)))
         f.write(chunk(b"IDAT", zlib.compress(rows, 9)))
         f.write(chunk(b"IEND", b""))
-
-
-def load_exr(path):
-    with OpenEXR.File(path) as f:
-        ch = f.channels()
-        if "RGB" in ch:
-            return np.array(ch["RGB"].pixels, dtype=np.float64)
-        return np.stack([np.array(ch[c].pixels, dtype=np.float64) for c in "RGB"], -1)
-
-
-def save_exr(path, img):
-    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
-    with OpenEXR.File(header, {"RGB": np.ascontiguousarray(img, dtype=np.float32)}) as f:
-        f.write(path)
 
 
 # ---------------------------------------------------------------- the normal map
