@@ -1,6 +1,7 @@
 #include "accel/triangle.h"
 
 #include "accel/spherical_rectangle.h"
+#include "accel/spherical_triangle.h"
 #include "renderer/sampling.h"
 
 namespace ember {
@@ -57,6 +58,28 @@ bool Triangle::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) 
   hit.ng = normal_;
   hit.uv = (1.0f - b1 - b2) * uv_[0] + b1 * uv_[1] + b2 * uv_[2];
   return true;
+}
+
+bool Triangle::sampleSolidAngle(const Vec3& ref, Vec2 u, ShapeSample& s, float& pdf) const {
+  if (useSphericalTriangle(ref, v_[0], v_[1], v_[2], area_)) {
+    const SphericalTriangle st(v_[0], v_[1], v_[2], ref);
+    if (st.solidAngle() > kMinSphericalTriangle) {
+      const Vec2 b = barycentricsAlong(v_[0], v_[1], v_[2], ref, st.sample(u));
+      s.p = (1.0f - b.x - b.y) * v_[0] + b.x * v_[1] + b.y * v_[2];
+      s.n = normal_;
+      pdf = float(1.0 / st.solidAngle());
+      return true;
+    }
+  }
+  return Shape::sampleSolidAngle(ref, u, s, pdf);
+}
+
+float Triangle::pdfSolidAngle(const Vec3& ref, const Vec3& p, const Vec3& n) const {
+  if (useSphericalTriangle(ref, v_[0], v_[1], v_[2], area_)) {
+    const SphericalTriangle st(v_[0], v_[1], v_[2], ref);
+    if (st.solidAngle() > kMinSphericalTriangle) return float(1.0 / st.solidAngle());
+  }
+  return Shape::pdfSolidAngle(ref, p, n);
 }
 
 ShapeSample Triangle::sampleArea(Vec2 u) const {

@@ -2,7 +2,8 @@
 // The front normal is normalize(cross(v1 - v0, v2 - v0)). UVs are per-vertex and interpolated
 // barycentrically; defaults: triangle (0,0), (1,0), (0,1); quad (0,0), (1,0), (1,1), (0,1).
 // As a light, a rectangular quad seen from closer than about twice its size is sampled by solid
-// angle (spherical_rectangle.h); other quads, and rectangles seen from farther, by area.
+// angle (spherical_rectangle.h), and so is a triangle (spherical_triangle.h); other quads, and
+// shapes seen from farther, by area.
 #pragma once
 
 #include "accel/shape.h"
@@ -26,6 +27,9 @@ class Triangle final : public Shape {
   SurfacePoint projectToSurface(const Vec3& p, const LocalHit&) const override { return plane_.project(p); }
   float area() const override { return area_; }
   ShapeSample sampleArea(Vec2 u) const override;
+  // Seen from close by, uniform in the solid angle it subtends (accel/spherical_triangle.h).
+  bool sampleSolidAngle(const Vec3& ref, Vec2 u, ShapeSample& s, float& pdf) const override;
+  float pdfSolidAngle(const Vec3& ref, const Vec3& p, const Vec3& n) const override;
 
  private:
   std::array<Vec3, 3> v_;

@@ -1,6 +1,9 @@
 #include "renderer/light.h"
 
+#include "accel/spherical_triangle.h"
 #include "renderer/ray_spawn.h"
+
+#include <optional>
 #include "renderer/sampling.h"
 
 namespace ember {
@@ -80,10 +83,37 @@ TriangleLight::TriangleLight(const TriangleMesh* mesh, uint32_t prim, const Colo
       twoSided_(twoSided),
       pError_(mesh->pointError(prim)) {}
 
+// The spherical triangle of `prim` seen from ref, when light sampling should use it.
+static std::optional<SphericalTriangle> sphericalTriangle(const TriangleMesh& mesh, uint32_t prim,
+                                                          const Vec3& ref) {
+  const glm::uvec3& idx = mesh.indices[prim];
+  const Vec3 &v0 = mesh.positions[idx.x], &v1 = mesh.positions[idx.y], &v2 = mesh.positions[idx.z];
+  if (!useSphericalTriangle(ref, v0, v1, v2, mesh.triangleArea(prim))) return std::nullopt;
+  SphericalTriangle st(v0, v1, v2, ref);
+  if (!(st.solidAngle() > kMinSphericalTriangle)) return std::nullopt;
+  return st;
+}
+
+float TriangleLight::pdf(const Vec3& ref, const Vec3& p, const Vec3& n) const {
+  if (const auto st = sphericalTriangle(*mesh_, prim_, ref)) return float(1.0 / st->solidAngle());
+  return areaToSolidAnglePdf(1.0f / mesh_->triangleArea(prim_), ref, p, n);
+}
+
 bool TriangleLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
-  const Vec2 b = sampleUniformTriangle(u);
-  const TriangleMesh::Surface surface = mesh_->surfaceAt(prim_, b.y, 1.0f - b.x - b.y);
-  const Vec3 p = mesh_->pointAt(prim_, b.y, 1.0f - b.x - b.y);
+  // Barycentrics (b1, b2) of vertices 1 and 2: where a direction uniform in the solid angle meets
+  // the triangle, or a point uniform by area.
+  Vec2 b;
+  const std::optional<SphericalTriangle> st = sphericalTriangle(*mesh_, prim_, ref);
+  if (st) {
+    const glm::uvec3& idx = mesh_->indices[prim_];
+    b = barycentricsAlong(mesh_->positions[idx.x], mesh_->positions[idx.y], mesh_->positions[idx.z], ref,
+                          st->sample(u));
+  } else {
+    const Vec2 a = sampleUniformTriangle(u);  // barycentrics of vertices 0 and 1
+    b = Vec2(a.y, 1.0f - a.x - a.y);
+  }
+  const TriangleMesh::Surface surface = mesh_->surfaceAt(prim_, b.x, b.y);
+  const Vec3 p = mesh_->pointAt(prim_, b.x, b.y);
   const Vec3 d = p - ref;
   out.dist = glm::length(d);
   if (out.dist == 0.0f) return false;
@@ -91,7 +121,8 @@ bool TriangleLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
   out.p = p;
   out.n = surface.ng;
   out.pError = pError_;
-  out.pdf = pdf(ref, p, surface.ng);
+  out.pdf = st ? float(1.0 / st->solidAngle())
+               : areaToSolidAnglePdf(1.0f / mesh_->triangleArea(prim_), ref, p, surface.ng);
   out.delta = false;
   out.Li = twoSided_ || glm::dot(-out.wi, surface.ng) > 0.0f ? radiance_ : Color(0.0f);
   if (texture_) out.Li *= texture_->eval(surface.uv);

@@ -1,7 +1,8 @@
 // Lights, behind one interface that next-event estimation samples and MIS queries:
 //   PointLight        isotropic radiant intensity I [W/sr per channel]: irradiance I cos / d^2.
 //   AreaLight         a shape with constant radiance L on the side of its normal, or on both sides.
-//   TriangleLight     one triangle of an emissive mesh (glTF emissiveFactor), sampled by area; both
+//   TriangleLight     one triangle of an emissive mesh (glTF emissiveFactor), sampled by solid angle
+//                     when close, else by area; both
 //                     sides emit when the glTF material is doubleSided.
 //   EnvironmentLight  constant radiance arriving from every direction (the scene "background").
 #pragma once
@@ -119,9 +120,9 @@ class TriangleLight final : public Light {
   TriangleLight(const TriangleMesh* mesh, uint32_t prim, const Color& radiance,
                 const Texture* texture = nullptr, bool twoSided = false);
   bool sample(const Vec3& ref, Vec2 u, LightSample& out) const override;
-  float pdf(const Vec3& ref, const Vec3& p, const Vec3& n) const override {
-    return areaToSolidAnglePdf(1.0f / mesh_->triangleArea(prim_), ref, p, n);
-  }
+  // Seen from close by, uniform in the solid angle the triangle subtends (accel/spherical_triangle.h),
+  // else uniform by area.
+  float pdf(const Vec3& ref, const Vec3& p, const Vec3& n) const override;
   // With a texture, its mean over the whole image stands in for the mean over this triangle: power
   // only steers which light is sampled, so an estimate costs variance, never bias.
   Color power(float) const override {

@@ -94,7 +94,7 @@ namespace {
 // Parameters of the test as a whole.
 
 constexpr double kAlpha = 0.01;     // family-wise significance level over every case in the file
-constexpr int kNumCases = 63;       // m for the Sidak correction: must equal allCases().size()
+constexpr int kNumCases = 65;       // m for the Sidak correction: must equal allCases().size()
 constexpr long kSamples = 1000000;  // samples per case
 constexpr double kMinExpected = 5.0;
 // Absolute error allowed on integrals of the pdf over the sphere: the midpoint rule on the
@@ -625,6 +625,24 @@ void triangleLightCase(uint64_t seed) {
   runDirectional(c);
 }
 
+// From close by (0.15 in front of the triangle, off its centroid) TriangleLight samples the
+// spherical triangle (accel/spherical_triangle.h): uniform in solid angle, pdf 1 / omega.
+void triangleLightNearCase(uint64_t seed) {
+  const TriangleMesh mesh = lightMesh();
+  const TriangleLight light(&mesh, 1, Color(2.0f));
+  const Vec3 &a = mesh.positions[1], &b = mesh.positions[3], &cc = mesh.positions[2];
+  const Vec3 centroid = (a + b + cc) / 3.0f;
+  const Vec3 ref = centroid - 0.15f * glm::normalize(glm::cross(b - a, cc - a)) + 0.2f * (b - centroid);
+  Vec3 center;
+  const double r = boundingRadius({a, b, cc}, center);
+  DirectionalCase c;
+  c.grid = zoomedGrid(ref, center, r);
+  c.seed = seed;
+  c.sample = lightSampleFn(light, ref);
+  c.pdf = triangleLightPdf(mesh, 1, light, ref);
+  runDirectional(c);
+}
+
 void quadLightCase(uint64_t seed) {
   const Quad quad(quadVertices(), kQuadUv);
   const AreaLight light(&quad, Color(1.0f, 0.5f, 0.25f));
@@ -885,6 +903,13 @@ const std::vector<Chi2Case>& allCases() {
       const Vec3 n = glm::normalize(glm::cross(v[1] - v[0], v[2] - v[0]));
       flatShape(tri, {v.begin(), v.end()}, v[0] - 0.5f * n, s);
     });
+    // Close by, the triangle is sampled in the solid angle it subtends (accel/spherical_triangle.h).
+    add("Triangle_near_spherical", [](uint64_t s) {
+      const auto v = triangleVertices();
+      const Triangle tri(v, {Vec2(0, 0), Vec2(1, 0), Vec2(0, 1)});
+      const Vec3 n = glm::normalize(glm::cross(v[1] - v[0], v[2] - v[0]));
+      flatShape(tri, {v.begin(), v.end()}, 0.8f * v[1] + 0.2f * (v[0] + v[2]) / 2.0f + 0.03f * n, s);
+    });
     add("Quad_front", [](uint64_t s) {
       const auto v = quadVertices();
       const Quad quad(v, kQuadUv);
@@ -931,6 +956,7 @@ const std::vector<Chi2Case>& allCases() {
 
     // Lights.
     add("TriangleLight_directions", triangleLightCase);
+    add("TriangleLight_directions_near", triangleLightNearCase);
     add("AreaLightQuad_directions", quadLightCase);
     add("LightSampler_index_by_power", lightSamplerIndexCase);
     add("LightSampler_nee_mixture", lightSamplerMixtureCase);
