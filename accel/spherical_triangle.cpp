@@ -70,9 +70,13 @@ Vec2 barycentricsAlong(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Vec
   return Vec2(float(b1), float(b2));
 }
 
-bool useSphericalTriangle(const Vec3& ref, const Vec3& v0, const Vec3& v1, const Vec3& v2, float area) {
+std::optional<SphericalTriangle> sphericalTriangleForSampling(const Vec3& ref, const Vec3& v0, const Vec3& v1,
+                                                              const Vec3& v2, float area) {
   const Vec3 d = ref - (v0 + v1 + v2) / 3.0f;
-  return glm::dot(d, d) < 4.0f * area;
+  if (!(glm::dot(d, d) < 4.0f * area)) return std::nullopt;
+  SphericalTriangle st(v0, v1, v2, ref);
+  if (!(st.solidAngle() > 1e-4)) return std::nullopt;
+  return st;
 }
 
 }  // namespace ember

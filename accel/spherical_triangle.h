@@ -8,6 +8,8 @@
 
 #include "renderer/math.h"
 
+#include <optional>
+
 namespace ember {
 
 class SphericalTriangle {
@@ -31,10 +33,11 @@ class SphericalTriangle {
 // clamped into the triangle.
 Vec2 barycentricsAlong(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Vec3& o, const Vec3& w);
 
-// Whether light sampling from ref should use the spherical triangle: only close to the triangle,
-// where area sampling's variance is large, and where the solid angle is large enough to invert
-// precisely (a far triangle gains little and costs the inverse trigonometry; docs/performance.md).
-bool useSphericalTriangle(const Vec3& ref, const Vec3& v0, const Vec3& v1, const Vec3& v2, float area);
-inline constexpr double kMinSphericalTriangle = 1e-4;
+// The spherical triangle light sampling from ref should use, if any: only close to the triangle
+// (nearer than about twice its size), where area sampling's variance is large, and where the solid
+// angle exceeds 1e-4 sr so that the inversion stays precise (a far triangle gains little and would
+// cost the inverse trigonometry; docs/performance.md).
+std::optional<SphericalTriangle> sphericalTriangleForSampling(const Vec3& ref, const Vec3& v0, const Vec3& v1,
+                                                              const Vec3& v2, float area);
 
 }  // namespace ember

@@ -61,24 +61,19 @@ bool Triangle::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) 
 }
 
 bool Triangle::sampleSolidAngle(const Vec3& ref, Vec2 u, ShapeSample& s, float& pdf) const {
-  if (useSphericalTriangle(ref, v_[0], v_[1], v_[2], area_)) {
-    const SphericalTriangle st(v_[0], v_[1], v_[2], ref);
-    if (st.solidAngle() > kMinSphericalTriangle) {
-      const Vec2 b = barycentricsAlong(v_[0], v_[1], v_[2], ref, st.sample(u));
-      s.p = (1.0f - b.x - b.y) * v_[0] + b.x * v_[1] + b.y * v_[2];
-      s.n = normal_;
-      pdf = float(1.0 / st.solidAngle());
-      return true;
-    }
+  if (const auto st = sphericalTriangleForSampling(ref, v_[0], v_[1], v_[2], area_)) {
+    const Vec2 b = barycentricsAlong(v_[0], v_[1], v_[2], ref, st->sample(u));
+    s.p = (1.0f - b.x - b.y) * v_[0] + b.x * v_[1] + b.y * v_[2];
+    s.n = normal_;
+    pdf = float(1.0 / st->solidAngle());
+    return true;
   }
   return Shape::sampleSolidAngle(ref, u, s, pdf);
 }
 
 float Triangle::pdfSolidAngle(const Vec3& ref, const Vec3& p, const Vec3& n) const {
-  if (useSphericalTriangle(ref, v_[0], v_[1], v_[2], area_)) {
-    const SphericalTriangle st(v_[0], v_[1], v_[2], ref);
-    if (st.solidAngle() > kMinSphericalTriangle) return float(1.0 / st.solidAngle());
-  }
+  if (const auto st = sphericalTriangleForSampling(ref, v_[0], v_[1], v_[2], area_))
+    return float(1.0 / st->solidAngle());
   return Shape::pdfSolidAngle(ref, p, n);
 }
 

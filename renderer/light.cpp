@@ -87,11 +87,8 @@ TriangleLight::TriangleLight(const TriangleMesh* mesh, uint32_t prim, const Colo
 static std::optional<SphericalTriangle> sphericalTriangle(const TriangleMesh& mesh, uint32_t prim,
                                                           const Vec3& ref) {
   const glm::uvec3& idx = mesh.indices[prim];
-  const Vec3 &v0 = mesh.positions[idx.x], &v1 = mesh.positions[idx.y], &v2 = mesh.positions[idx.z];
-  if (!useSphericalTriangle(ref, v0, v1, v2, mesh.triangleArea(prim))) return std::nullopt;
-  SphericalTriangle st(v0, v1, v2, ref);
-  if (!(st.solidAngle() > kMinSphericalTriangle)) return std::nullopt;
-  return st;
+  return sphericalTriangleForSampling(ref, mesh.positions[idx.x], mesh.positions[idx.y],
+                                      mesh.positions[idx.z], mesh.triangleArea(prim));
 }
 
 float TriangleLight::pdf(const Vec3& ref, const Vec3& p, const Vec3& n) const {
