@@ -1,6 +1,6 @@
 #include "accel/disc.h"
 
-#include "renderer/sampling.h"
+#include "core/sampling.h"
 
 namespace ember {
 

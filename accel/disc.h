@@ -1,5 +1,5 @@
 // Disc: a flat, zero-thickness circle with a front normal. UV is planar: u = 0.5 + x / (2R),
-// v = 0.5 - y / (2R) over the disc's tangent frame (renderer/math.h Frame of the normal), so a
+// v = 0.5 - y / (2R) over the disc's tangent frame (core/math.h Frame of the normal), so a
 // square texture maps onto the disc's bounding square. Also the caps of cylinders and cones.
 #pragma once
 

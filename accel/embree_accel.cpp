@@ -1,7 +1,7 @@
 #include "accel/embree_accel.h"
 
 #include "accel/user_geometry.h"
-#include "renderer/rng.h"
+#include "core/rng.h"
 
 #include <cstdio>
 #include <cstring>

@@ -4,8 +4,8 @@
 // "front" side, the side an emitting shape emits on.
 #pragma once
 
-#include "renderer/math.h"
-#include "renderer/ray_spawn.h"
+#include "core/math.h"
+#include "core/ray_spawn.h"
 
 #include <string_view>
 
@@ -33,7 +33,7 @@ struct LocalHit {
   Vec2 uv{0.0f};
 };
 
-// A hit point rebuilt on the surface, with the bound of its rounding error (renderer/ray_spawn.h).
+// A hit point rebuilt on the surface, with the bound of its rounding error (core/ray_spawn.h).
 struct SurfacePoint {
   Vec3 p;
   float error;

@@ -1,7 +1,7 @@
 #include "accel/sphere.h"
 
 #include "accel/solve.h"
-#include "renderer/sampling.h"
+#include "core/sampling.h"
 
 namespace ember {
 

@@ -4,7 +4,7 @@
 // and cosine variation that area sampling leaves in next-event estimation close to a light.
 #pragma once
 
-#include "renderer/math.h"
+#include "core/math.h"
 
 namespace ember {
 

@@ -6,7 +6,7 @@
 // in float near the triangle's edges.
 #pragma once
 
-#include "renderer/math.h"
+#include "core/math.h"
 
 #include <optional>
 

@@ -2,7 +2,7 @@
 
 #include "accel/spherical_rectangle.h"
 #include "accel/spherical_triangle.h"
-#include "renderer/sampling.h"
+#include "core/sampling.h"
 
 namespace ember {
 

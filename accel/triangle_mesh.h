@@ -41,7 +41,7 @@ struct TriangleMesh {
   Surface surfaceAt(uint32_t prim, float b1, float b2) const;
   Vec2 uvAt(uint32_t prim, float b1, float b2) const;
   // The point at barycentrics (b1, b2) of triangle `prim`, interpolated from its vertices, with the
-  // rounding-error bound of points computed from them (renderer/ray_spawn.h).
+  // rounding-error bound of points computed from them (core/ray_spawn.h).
   Vec3 pointAt(uint32_t prim, float b1, float b2) const;
   float pointError(uint32_t prim) const;
 

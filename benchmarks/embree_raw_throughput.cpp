@@ -6,7 +6,7 @@
 // cost of our intersection callbacks, exactly as Ember pays it.
 //   embree_raw_throughput [scene.json] [--rays N]
 #include "io/scene_loader.h"
-#include "renderer/sampling.h"
+#include "core/sampling.h"
 
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>

@@ -13,7 +13,7 @@
 #include "materials/phong.h"
 #include "materials/specular.h"
 #include "renderer/sampler.h"
-#include "renderer/sampling.h"
+#include "core/sampling.h"
 #include "renderer/scene.h"
 
 #include <benchmark/benchmark.h>

@@ -4,7 +4,7 @@
 #pragma once
 
 #include "io/input_error.h"
-#include "renderer/math.h"
+#include "core/math.h"
 
 #include <nlohmann/json.hpp>
 

@@ -1,7 +1,7 @@
 // Specular reflection, refraction and the exact Fresnel equations for dielectrics.
 #pragma once
 
-#include "renderer/math.h"
+#include "core/math.h"
 
 namespace ember {
 

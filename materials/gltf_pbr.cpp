@@ -44,7 +44,7 @@
 #include "materials/gltf_pbr.h"
 
 #include "materials/fresnel.h"
-#include "renderer/sampling.h"
+#include "core/sampling.h"
 
 namespace ember {
 

@@ -1,6 +1,6 @@
 #include "materials/lambertian.h"
 
-#include "renderer/sampling.h"
+#include "core/sampling.h"
 
 namespace ember {
 

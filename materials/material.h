@@ -3,7 +3,7 @@
 // surface: wo towards the previous path vertex, wi towards the next one.
 #pragma once
 
-#include "renderer/surface_hit.h"
+#include "core/surface_hit.h"
 
 #include <string_view>
 

@@ -14,7 +14,7 @@
 //    Schlick F).
 #pragma once
 
-#include "renderer/math.h"
+#include "core/math.h"
 
 namespace ember {
 

@@ -1,7 +1,7 @@
 #include "materials/mixed.h"
 
 #include "materials/specular.h"
-#include "renderer/sampling.h"
+#include "core/sampling.h"
 
 namespace ember {
 

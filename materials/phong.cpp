@@ -1,6 +1,6 @@
 #include "materials/phong.h"
 
-#include "renderer/sampling.h"
+#include "core/sampling.h"
 
 namespace ember {
 

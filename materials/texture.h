@@ -3,7 +3,7 @@
 // no v flip (glTF uses the same convention). Texel values are stored linear.
 #pragma once
 
-#include "renderer/math.h"
+#include "core/math.h"
 
 #include <memory>
 #include <string>

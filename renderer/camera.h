@@ -5,7 +5,7 @@
 // along f and starts at origin + (2x/W - 1) ymag (W/H) r + (1 - 2y/H) ymag u.
 #pragma once
 
-#include "renderer/math.h"
+#include "core/math.h"
 
 namespace ember {
 

@@ -3,7 +3,7 @@
 // each pixel mean is available too.
 #pragma once
 
-#include "renderer/math.h"
+#include "core/math.h"
 
 #include <cstdint>
 #include <vector>

@@ -1,10 +1,10 @@
 #include "renderer/light.h"
 
 #include "accel/spherical_triangle.h"
-#include "renderer/ray_spawn.h"
+#include "core/ray_spawn.h"
 
 #include <optional>
-#include "renderer/sampling.h"
+#include "core/sampling.h"
 
 namespace ember {
 

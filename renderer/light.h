@@ -10,7 +10,7 @@
 #include "accel/shape.h"
 #include "accel/triangle_mesh.h"
 #include "materials/texture.h"
-#include "renderer/distribution.h"
+#include "core/distribution.h"
 
 #include <memory>
 
@@ -20,7 +20,7 @@ struct LightSample {
   Vec3 wi;              // unit direction from the reference point towards the light
   Vec3 p;               // the sampled point (unused for infinite lights)
   Vec3 n{0.0f};         // unit surface normal at p; zero for point and spot lights
-  float pError = 0.0f;  // rounding-error bound of p (renderer/ray_spawn.h); 0 for exact positions
+  float pError = 0.0f;  // rounding-error bound of p (core/ray_spawn.h); 0 for exact positions
   float dist = kInfinity;
   Color Li{0.0f};    // radiance (or, for delta lights, intensity / d^2) arriving at the ref
   float pdf = 0.0f;  // solid-angle density of wi; 1 for delta lights

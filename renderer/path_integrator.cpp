@@ -1,6 +1,6 @@
 #include "renderer/path_integrator.h"
 
-#include "renderer/sampling.h"
+#include "core/sampling.h"
 
 namespace ember {
 

@@ -1,6 +1,6 @@
 // The random numbers of one camera sample, dimension by dimension.
 //
-// Independent: every number from the sample's own PCG32 stream (renderer/rng.h), as Mitsuba's
+// Independent: every number from the sample's own PCG32 stream (core/rng.h), as Mitsuba's
 //   `independent` sampler.
 // Sobol: each successive 1D or 2D request is a dimension (pair) of an Owen-scrambled Sobol
 //   (0,2)-sequence over the pixel's sample indices, with the sample order shuffled independently per
@@ -13,8 +13,8 @@
 // range of sample indices rendered separately merges exactly with the rest.
 #pragma once
 
-#include "renderer/math.h"
-#include "renderer/rng.h"
+#include "core/math.h"
+#include "core/rng.h"
 
 #include <cstdint>
 

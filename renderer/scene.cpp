@@ -79,7 +79,7 @@ bool Scene::intersect(const Ray& ray, SurfaceHit& hit) const {
   hit.t = raw.t;
   hit.p = ray.origin + raw.t * ray.dir;
   // The rounding error of o + t d grows with t, and with it the offset of every ray leaving the
-  // hit (renderer/ray_spawn.h). So a triangle's hit point is interpolated from its vertices, and a
+  // hit (core/ray_spawn.h). So a triangle's hit point is interpolated from its vertices, and a
   // shape's hit found from farther away than its own coordinates' magnitude is projected onto
   // the shape: either way the error then depends on the scene's coordinates, not on how far the
   // ray came. (Nearer hits keep o + t d, whose bound is then at most twice the projected one; the

@@ -10,7 +10,7 @@
 #include "renderer/light_sampler.h"
 #include "renderer/sampler.h"
 #include "renderer/strategy.h"
-#include "renderer/surface_hit.h"
+#include "core/surface_hit.h"
 
 #include <memory>
 #include <optional>
@@ -68,7 +68,7 @@ class Scene {
   bool built() const { return accel_ != nullptr; }
 
   bool intersect(const Ray& ray, SurfaceHit& hit) const;
-  // True when something blocks the ray before ray.tMax (a shadow ray from renderer/ray_spawn.h).
+  // True when something blocks the ray before ray.tMax (a shadow ray from core/ray_spawn.h).
   bool occluded(const Ray& ray) const;
 
   const Camera& camera() const { return camera_; }

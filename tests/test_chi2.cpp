@@ -66,8 +66,8 @@
 #include "materials/texture.h"
 #include "renderer/light.h"
 #include "renderer/light_sampler.h"
-#include "renderer/rng.h"
-#include "renderer/sampling.h"
+#include "core/rng.h"
+#include "core/sampling.h"
 #include "test_fixtures.h"
 
 #include <gtest/gtest.h>

@@ -7,7 +7,7 @@
 #include "mc_mean.h"
 #include "renderer/path_integrator.h"
 #include "renderer/render.h"
-#include "renderer/sampling.h"
+#include "core/sampling.h"
 
 #include <gtest/gtest.h>
 

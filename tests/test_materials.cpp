@@ -18,8 +18,8 @@
 #include "materials/phong.h"
 #include "materials/specular.h"
 #include "materials/texture.h"
-#include "renderer/rng.h"
-#include "renderer/sampling.h"
+#include "core/rng.h"
+#include "core/sampling.h"
 
 #include <gtest/gtest.h>
 

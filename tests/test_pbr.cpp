@@ -28,7 +28,7 @@
 
 #include "materials/gltf_pbr.h"
 #include "materials/texture.h"
-#include "renderer/rng.h"
+#include "core/rng.h"
 
 #include <gtest/gtest.h>
 

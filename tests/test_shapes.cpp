@@ -22,10 +22,10 @@
 #include "materials/fresnel.h"
 #include "materials/lambertian.h"
 #include "materials/texture.h"
-#include "renderer/rng.h"
-#include "renderer/sampling.h"
+#include "core/rng.h"
+#include "core/sampling.h"
 #include "renderer/scene.h"
-#include "renderer/surface_hit.h"
+#include "core/surface_hit.h"
 
 #include <gtest/gtest.h>
 
@@ -890,7 +890,7 @@ void runSpawnTest(const Vec3& offset, uint64_t seed, float distance = 1.0f) {
   }
 }
 
-// Shadow rays to every shape as an emitter (renderer/ray_spawn.h spawnRayTo): from points in front
+// Shadow rays to every shape as an emitter (core/ray_spawn.h spawnRayTo): from points in front
 // of a sampled point, at 1e-3 to 3 sizes and down to grazing angles, on a receiver whose normal
 // faces the light and whose origin offset is that of a hit seen from one size away (and which is
 // farther from the emitter than that offset and the light sample's error together), a ray to a

@@ -3,7 +3,7 @@
 // conditional within the chosen row. Densities are with respect to [0, 1) and [0, 1)^2.
 #pragma once
 
-#include "renderer/math.h"
+#include "core/math.h"
 
 #include <vector>
 

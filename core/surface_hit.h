@@ -1,8 +1,8 @@
 // Everything shading needs about a ray's hit point, in world space.
 #pragma once
 
-#include "renderer/math.h"
-#include "renderer/ray_spawn.h"
+#include "core/math.h"
+#include "core/ray_spawn.h"
 
 #include <cstdint>
 
@@ -17,7 +17,7 @@ struct SurfaceHit {
   Vec3 ns;  // unit shading normal, in the same hemisphere as ng
   Vec2 uv;
   float t = 0.0f;
-  float pError = roundingErrorBound(0.0f);  // rounding-error bound of p (renderer/ray_spawn.h)
+  float pError = roundingErrorBound(0.0f);  // rounding-error bound of p (core/ray_spawn.h)
   const Material* material = nullptr;
   const Light* light = nullptr;   // the area light this surface belongs to, if it emits
   Color emission{0.0f};           // radiance emitted on the side of ng

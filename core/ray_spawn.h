@@ -6,7 +6,7 @@
 // the normal puts it strictly on the side the ray travels to.
 #pragma once
 
-#include "renderer/math.h"
+#include "core/math.h"
 
 namespace ember {
 

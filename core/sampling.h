@@ -2,7 +2,7 @@
 // Derivations: Pharr, Jakob, Humphreys, "Physically Based Rendering" 4th ed. (PBRT4), ch. A.5.
 #pragma once
 
-#include "renderer/math.h"
+#include "core/math.h"
 
 namespace ember {
 

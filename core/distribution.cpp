@@ -1,4 +1,4 @@
-#include "renderer/distribution.h"
+#include "core/distribution.h"
 
 #include <algorithm>
 
