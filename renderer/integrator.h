@@ -1,6 +1,8 @@
-// The integrator interface: radiance arriving along a camera ray, estimated with one path.
+// The integrator interface: radiance arriving along a camera ray, estimated with one path, and
+// the unit of work the tile scheduler hands out: all samples of a rectangle of pixels.
 #pragma once
 
+#include "renderer/film.h"
 #include "renderer/sampler.h"
 #include "renderer/scene.h"
 
@@ -13,19 +15,43 @@ struct PathStats {
   uint64_t rays = 0;        // closest-hit queries
   uint64_t shadowRays = 0;  // occlusion queries
   uint64_t vertices = 0;    // surface hits
+  uint64_t nonFinite = 0;   // samples dropped because they were NaN or infinite
 
   PathStats& operator+=(const PathStats& o) {
     rays += o.rays;
     shadowRays += o.shadowRays;
     vertices += o.vertices;
+    nonFinite += o.nonFinite;
     return *this;
   }
+};
+
+// Pixels [x0, x1) x [y0, y1) and sample indices [firstSample, firstSample + spp) of each.
+struct TileWork {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  uint64_t firstSample = 0;
+  int spp = 1;
+  uint64_t seed = 0;
+  SamplerType sampler = SamplerType::Independent;
 };
 
 class Integrator {
  public:
   virtual ~Integrator() = default;
   virtual Color Li(const Scene& scene, Ray ray, Sampler& sampler, PathStats& stats) const = 0;
+
+  // Adds every sample of the tile to the film. Each (pixel, sample index) has its own sampler,
+  // and a pixel's samples reach the film in the order of their indices, so any implementation
+  // that estimates the same paths produces the same film. This one traces each path alone, one
+  // ray at a time, pixel by pixel.
+  virtual void renderTile(const Scene& scene, const TileWork& work, Film& film, PathStats& stats) const;
 };
+
+// The camera sample (pixel, index) of a tile: its sampler, and the ray through its jittered
+// raster position (the sampler's first 2D request).
+Ray cameraRay(const Scene& scene, int x, int y, Sampler& sampler);
+
+// Adds a finished sample to the film, or counts it in stats.nonFinite if it is NaN or infinite.
+void addToFilm(Film& film, int x, int y, const Color& L, PathStats& stats);
 
 }  // namespace ember

@@ -4,26 +4,24 @@
 
 namespace ember {
 
-Color PathIntegrator::sampleLight(const Scene& scene, const SurfaceHit& hit, const Vec3& wo, Sampler& sampler,
-                                  PathStats& stats) const {
+bool PathIntegrator::sampleLight(const Scene& scene, const SurfaceHit& hit, const Vec3& wo, Sampler& sampler,
+                                 ShadowRequest& shadow) const {
   float pick;
   const Light* light = scene.lightSampler().sample(sampler.get1D(), pick);
   const Vec2 u = sampler.get2D();
   LightSample ls;
-  if (!light || !light->sample(hit.p, u, ls) || ls.pdf <= 0.0f || isBlack(ls.Li)) return Color(0.0f);
+  if (!light || !light->sample(hit.p, u, ls) || ls.pdf <= 0.0f || isBlack(ls.Li)) return false;
   float bsdfPdf = 0.0f;
   const Color f = hit.material->evalPdf(hit, wo, ls.wi, bsdfPdf);
-  if (isBlack(f)) return Color(0.0f);
+  if (isBlack(f)) return false;
 
   // Lights at a finite distance: a segment between the two points that neither surface blocks.
-  const Ray shadow = std::isfinite(ls.dist) ? spawnRayTo(hit.p, hit.ng, hit.pError, ls.p, ls.n, ls.pError)
-                                            : Ray{hit.offsetOrigin(ls.wi), ls.wi, kInfinity};
-  ++stats.shadowRays;
-  if (scene.occluded(shadow)) return Color(0.0f);
-
+  shadow.ray = std::isfinite(ls.dist) ? spawnRayTo(hit.p, hit.ng, hit.pError, ls.p, ls.n, ls.pError)
+                                      : Ray{hit.offsetOrigin(ls.wi), ls.wi, kInfinity};
   const float lightPdf = pick * ls.pdf;
   const float weight = ls.delta || strategy_ == Strategy::Light ? 1.0f : powerHeuristic(lightPdf, bsdfPdf);
-  return f * ls.Li * (weight / lightPdf);
+  shadow.contribution = f * ls.Li * (weight / lightPdf);
+  return true;
 }
 
 float PathIntegrator::emissionWeight(float bsdfPdf, float lightPdf) const {
@@ -38,69 +36,93 @@ float PathIntegrator::emissionWeight(float bsdfPdf, float lightPdf) const {
   return powerHeuristic(bsdfPdf, lightPdf);
 }
 
-Color PathIntegrator::Li(const Scene& scene, Ray ray, Sampler& sampler, PathStats& stats) const {
-  Color radiance(0.0f);
-  Color throughput(1.0f);
-  float etaProduct = 1.0f;
-  bool previousDelta = true;  // camera rays count as specular: emitters they see get weight 1
-  float previousPdf = 0.0f;
-  Vec3 previousPoint = ray.origin;
-  const LightSampler& lights = scene.lightSampler();
-  if (maxDepth_ == 0) return radiance;  // paths of zero segments carry no light (as in Mitsuba)
+bool PathIntegrator::start(const Ray& cameraRay, PathState& path) const {
+  path = PathState{};
+  path.ray = cameraRay;
+  path.previousPoint = cameraRay.origin;
+  return maxDepth_ != 0;  // paths of zero segments carry no light (as in Mitsuba)
+}
 
-  for (int depth = 1;; ++depth) {
+void PathIntegrator::onMiss(const Scene& scene, PathState& path) const {
+  if (const EnvironmentLight* env = scene.environment()) {
+    float weight = 1.0f;
+    if (!path.previousDelta)
+      weight = emissionWeight(path.previousPdf, scene.lightSampler().pmf(env) * env->pdfDirection(path.ray.dir));
+    path.radiance += path.throughput * env->radiance(path.ray.dir) * weight;
+  }
+}
+
+bool PathIntegrator::onHit(const Scene& scene, PathState& path, const SurfaceHit& hit, Sampler& sampler,
+                           PathStats& stats, ShadowRequest& shadow, bool& continues) const {
+  continues = false;
+  ++stats.vertices;
+  const Ray& ray = path.ray;
+  const Vec3 wo = -ray.dir;
+  if (hit.material && glm::dot(ray.dir, hit.ng) > 0.0f) {
+    path.throughput *= hit.material->interiorTransmittance(hit.t);
+    if (isBlack(path.throughput)) return false;
+  }
+
+  const LightSampler& lights = scene.lightSampler();
+  const Color emitted = hit.emitted(wo);
+  if (!isBlack(emitted)) {
+    float weight = 1.0f;
+    if (!path.previousDelta) {
+      const float lightPdf =
+          hit.light ? lights.pmf(hit.light) * hit.light->pdf(path.previousPoint, hit.p, hit.ng) : 0.0f;
+      weight = emissionWeight(path.previousPdf, lightPdf);
+    }
+    path.radiance += path.throughput * emitted * weight;
+  }
+
+  if ((maxDepth_ >= 0 && path.depth >= maxDepth_) || !hit.material) return false;
+
+  bool hasShadow = false;
+  if (strategy_ != Strategy::Bsdf && hit.material->hasNonDeltaLobes() && !lights.empty() &&
+      sampleLight(scene, hit, wo, sampler, shadow)) {
+    shadow.contribution = path.throughput * shadow.contribution;
+    ++stats.shadowRays;
+    hasShadow = true;
+  }
+
+  BsdfSample bs;
+  const Vec2 u = sampler.get2D();
+  if (!hit.material->sample(hit, wo, u, sampler.get1D(), bs)) return hasShadow;
+  path.throughput *= bs.weight;
+  if (isBlack(path.throughput)) return hasShadow;
+  path.previousDelta = bs.delta;
+  path.previousPdf = bs.pdf;
+  path.previousPoint = hit.p;
+  path.etaProduct *= bs.eta;
+  path.ray = Ray{hit.offsetOrigin(bs.wi), bs.wi};
+
+  if (path.depth >= rrDepth_) {
+    const float q = std::min(maxComponent(path.throughput) * path.etaProduct * path.etaProduct, 0.95f);
+    if (sampler.get1D() >= q) return hasShadow;
+    path.throughput /= q;
+  }
+  ++path.depth;
+  continues = true;
+  return hasShadow;
+}
+
+Color PathIntegrator::Li(const Scene& scene, Ray ray, Sampler& sampler, PathStats& stats) const {
+  PathState path;
+  if (!start(ray, path)) return path.radiance;
+  for (;;) {
     SurfaceHit hit;
     ++stats.rays;
-    if (!scene.intersect(ray, hit)) {
-      if (const EnvironmentLight* env = scene.environment()) {
-        float weight = 1.0f;
-        if (!previousDelta)
-          weight = emissionWeight(previousPdf, lights.pmf(env) * env->pdfDirection(ray.dir));
-        radiance += throughput * env->radiance(ray.dir) * weight;
-      }
+    if (!scene.intersect(path.ray, hit)) {
+      onMiss(scene, path);
       break;
     }
-    ++stats.vertices;
-    const Vec3 wo = -ray.dir;
-    if (hit.material && glm::dot(ray.dir, hit.ng) > 0.0f) {
-      throughput *= hit.material->interiorTransmittance(hit.t);
-      if (isBlack(throughput)) break;
-    }
-
-    const Color emitted = hit.emitted(wo);
-    if (!isBlack(emitted)) {
-      float weight = 1.0f;
-      if (!previousDelta) {
-        const float lightPdf =
-            hit.light ? lights.pmf(hit.light) * hit.light->pdf(previousPoint, hit.p, hit.ng) : 0.0f;
-        weight = emissionWeight(previousPdf, lightPdf);
-      }
-      radiance += throughput * emitted * weight;
-    }
-
-    if ((maxDepth_ >= 0 && depth >= maxDepth_) || !hit.material) break;
-
-    if (strategy_ != Strategy::Bsdf && hit.material->hasNonDeltaLobes() && !lights.empty())
-      radiance += throughput * sampleLight(scene, hit, wo, sampler, stats);
-
-    BsdfSample bs;
-    const Vec2 u = sampler.get2D();
-    if (!hit.material->sample(hit, wo, u, sampler.get1D(), bs)) break;
-    throughput *= bs.weight;
-    if (isBlack(throughput)) break;
-    previousDelta = bs.delta;
-    previousPdf = bs.pdf;
-    previousPoint = hit.p;
-    etaProduct *= bs.eta;
-    ray = Ray{hit.offsetOrigin(bs.wi), bs.wi};
-
-    if (depth >= rrDepth_) {
-      const float q = std::min(maxComponent(throughput) * etaProduct * etaProduct, 0.95f);
-      if (sampler.get1D() >= q) break;
-      throughput /= q;
-    }
+    ShadowRequest shadow;
+    bool continues;
+    if (onHit(scene, path, hit, sampler, stats, shadow, continues) && !scene.occluded(shadow.ray))
+      path.radiance += shadow.contribution;
+    if (!continues) break;
   }
-  return radiance;
+  return path.radiance;
 }
 
 std::string unreachableLightsWarning(const Scene& scene, Strategy strategy) {

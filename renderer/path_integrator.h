@@ -30,16 +30,50 @@
 
 namespace ember {
 
+// One path between two ray casts: the ray it casts next and what it has gathered so far.
+struct PathState {
+  Ray ray;
+  Color radiance{0.0f};
+  Color throughput{1.0f};
+  float etaProduct = 1.0f;
+  bool previousDelta = true;  // camera rays count as specular: emitters they see get weight 1
+  float previousPdf = 0.0f;
+  Vec3 previousPoint{0.0f};
+  int depth = 1;  // segments cast so far, counting the one in flight
+};
+
+// Next-event estimation's shadow ray: if nothing blocks it, `contribution` (throughput included)
+// is added to its path's radiance.
+struct ShadowRequest {
+  Ray ray;
+  Color contribution;
+};
+
 class PathIntegrator final : public Integrator {
  public:
   PathIntegrator(int maxDepth, int rrDepth, Strategy strategy = Strategy::Mis)
       : maxDepth_(maxDepth), rrDepth_(rrDepth), strategy_(strategy) {}
   explicit PathIntegrator(const RenderSettings& s) : PathIntegrator(s.maxDepth, s.rrDepth, s.strategy) {}
+
+  // The scalar reference: casts each ray of the path alone, as soon as it is known.
   Color Li(const Scene& scene, Ray ray, Sampler& sampler, PathStats& stats) const override;
 
+  // The path as a state machine, for Li and for loops that cast the rays of many paths together
+  // (packet/wavefront_integrator.h). Both call the same steps in the same order per path, so
+  // they estimate the same value bit for bit.
+  // A path starting with a camera ray; false if it can carry no light (max depth 0).
+  bool start(const Ray& cameraRay, PathState& path) const;
+  // The path's ray left the scene: adds the environment it sees. The path ends.
+  void onMiss(const Scene& scene, PathState& path) const;
+  // The path's ray found `hit`: adds its emission, asks for a shadow ray (returns true and fills
+  // `shadow`) and samples the next ray into path.ray. `continues` says whether the path goes on.
+  // The shadow ray's contribution must be added before the path's next step.
+  bool onHit(const Scene& scene, PathState& path, const SurfaceHit& hit, Sampler& sampler, PathStats& stats,
+             ShadowRequest& shadow, bool& continues) const;
+
  private:
-  Color sampleLight(const Scene& scene, const SurfaceHit& hit, const Vec3& wo, Sampler& sampler,
-                    PathStats& stats) const;
+  bool sampleLight(const Scene& scene, const SurfaceHit& hit, const Vec3& wo, Sampler& sampler,
+                   ShadowRequest& shadow) const;
   // Weight of emission that a BSDF-sampled direction (density bsdfPdf) found, where light sampling
   // would have produced it with density lightPdf.
   float emissionWeight(float bsdfPdf, float lightPdf) const;

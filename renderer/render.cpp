@@ -27,9 +27,7 @@ RenderStats render(const Scene& scene, const Integrator& integrator, const Rende
   RenderStats stats;
   stats.threads = threads;
   std::mutex statsMutex;
-  std::atomic<uint64_t> nonFinite{0};
   ProgressReporter progress(uint64_t(width) * uint64_t(height), uint64_t(options.spp), options.progress);
-  const Camera& camera = scene.camera();
 
   const auto start = std::chrono::steady_clock::now();
   tbb::task_arena arena(threads);
@@ -41,28 +39,19 @@ RenderStats render(const Scene& scene, const Integrator& integrator, const Rende
           _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
           _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
           PathStats local;
-          uint64_t localNonFinite = 0;
           for (int t = range.begin(); t != range.end(); ++t) {
-            const int x0 = (t % tilesX) * tile, y0 = (t / tilesX) * tile;
-            const int x1 = std::min(x0 + tile, width), y1 = std::min(y0 + tile, height);
-            for (int y = y0; y < y1; ++y)
-              for (int x = x0; x < x1; ++x) {
-                const uint64_t pixel = uint64_t(y) * uint64_t(width) + uint64_t(x);
-                for (int s = 0; s < options.spp; ++s) {
-                  Sampler sampler(options.sampler, options.seed, pixel, options.firstSample + uint64_t(s));
-                  const Vec2 jitter = sampler.get2D();
-                  const Ray ray = camera.generateRay(float(x) + jitter.x, float(y) + jitter.y);
-                  const Color L = integrator.Li(scene, ray, sampler, local);
-                  if (isFinite(L)) {
-                    film.addSample(x, y, L);
-                  } else {
-                    ++localNonFinite;
-                  }
-                }
-              }
-            progress.advance(uint64_t(x1 - x0) * uint64_t(y1 - y0));
+            TileWork work;
+            work.x0 = (t % tilesX) * tile;
+            work.y0 = (t / tilesX) * tile;
+            work.x1 = std::min(work.x0 + tile, width);
+            work.y1 = std::min(work.y0 + tile, height);
+            work.firstSample = options.firstSample;
+            work.spp = options.spp;
+            work.seed = options.seed;
+            work.sampler = options.sampler;
+            integrator.renderTile(scene, work, film, local);
+            progress.advance(uint64_t(work.x1 - work.x0) * uint64_t(work.y1 - work.y0));
           }
-          nonFinite.fetch_add(localNonFinite, std::memory_order_relaxed);
           std::lock_guard<std::mutex> lock(statsMutex);
           stats.paths += local;
         },
@@ -71,7 +60,7 @@ RenderStats render(const Scene& scene, const Integrator& integrator, const Rende
   progress.finish();
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   stats.samples = uint64_t(width) * uint64_t(height) * uint64_t(options.spp);
-  stats.nonFinite = nonFinite.load();
+  stats.nonFinite = stats.paths.nonFinite;
   return stats;
 }
 

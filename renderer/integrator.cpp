@@ -1,0 +1,31 @@
+#include "renderer/integrator.h"
+
+namespace ember {
+
+Ray cameraRay(const Scene& scene, int x, int y, Sampler& sampler) {
+  const Vec2 jitter = sampler.get2D();
+  return scene.camera().generateRay(float(x) + jitter.x, float(y) + jitter.y);
+}
+
+void addToFilm(Film& film, int x, int y, const Color& L, PathStats& stats) {
+  if (isFinite(L)) {
+    film.addSample(x, y, L);
+  } else {
+    ++stats.nonFinite;
+  }
+}
+
+void Integrator::renderTile(const Scene& scene, const TileWork& work, Film& film, PathStats& stats) const {
+  const uint64_t width = uint64_t(film.width());
+  for (int y = work.y0; y < work.y1; ++y)
+    for (int x = work.x0; x < work.x1; ++x) {
+      const uint64_t pixel = uint64_t(y) * width + uint64_t(x);
+      for (int s = 0; s < work.spp; ++s) {
+        Sampler sampler(work.sampler, work.seed, pixel, work.firstSample + uint64_t(s));
+        const Ray ray = cameraRay(scene, x, y, sampler);
+        addToFilm(film, x, y, Li(scene, ray, sampler, stats), stats);
+      }
+    }
+}
+
+}  // namespace ember
