@@ -4,7 +4,7 @@
 
 #include "io/input_error.h"
 #include "io/scene_loader.h"
-#include "renderer/path_integrator.h"
+#include "packet/wavefront_integrator.h"
 #include "renderer/render.h"
 
 #include <sys/resource.h>
@@ -66,6 +66,7 @@ struct BenchArgs {
   int threads = 0;
   int repeat = 3;
   std::string json;
+  std::string kernel = "wavefront";
 };
 
 int runBench(const BenchArgs& a) {
@@ -81,6 +82,7 @@ int runBench(const BenchArgs& a) {
   report["machine"] = {{"cpu", cpuModel()}, {"cores", tbb::info::default_concurrency()}};
   report["threads"] = a.threads > 0 ? a.threads : tbb::info::default_concurrency();
   report["repeat"] = a.repeat;
+  report["kernel"] = a.kernel;
   report["scenes"] = nlohmann::json::array();
 
   std::printf("%-22s %7s %5s %8s %8s %9s %10s %10s %10s %10s %9s %8s %8s\n", "scene", "spp", "thr", "load s",
@@ -98,7 +100,7 @@ int runBench(const BenchArgs& a) {
       std::fprintf(stderr, "ember: warning: %s: %s\n", path.c_str(), w.c_str());
     report["machine"]["isa"] = scene.accel().isaName();
 
-    const PathIntegrator integrator(scene.settings);
+    const std::unique_ptr<Integrator> integrator = makeIntegrator(scene.settings, *parseKernel(a.kernel));
     RenderOptions options;
     options.spp = scene.settings.spp;
     options.seed = scene.settings.seed;
@@ -108,7 +110,7 @@ int runBench(const BenchArgs& a) {
     double anonymousMb = 0.0;
     for (int k = 0; k < a.repeat; ++k) {
       Film film(scene.settings.width, scene.settings.height);
-      runs.push_back(render(scene, integrator, options, film));
+      runs.push_back(render(scene, *integrator, options, film));
       anonymousMb = std::max(anonymousMb, anonymousResidentMb());  // scene, BVH and film alive
     }
     std::sort(runs.begin(), runs.end(),
@@ -174,6 +176,8 @@ Runner addBenchCommand(CLI::App& app) {
       ->check(CLI::Range(1, 4096));
   cmd->add_option("--repeat", args->repeat, "Renders per scene; the median is reported (default 3)")
       ->check(CLI::Range(1, 1000));
+  cmd->add_option("--kernel", args->kernel, "wavefront (default), stream or scalar; see `ember render --help`")
+      ->check(CLI::IsMember({"wavefront", "stream", "scalar"}));
   cmd->add_option("--json", args->json, "Also write the results as JSON (layout: docs/performance.md)");
   return [args] { return runBench(*args); };
 }

@@ -4,7 +4,7 @@
 #include "io/input_error.h"
 #include "io/scene_loader.h"
 #include "io/tonemap.h"
-#include "renderer/path_integrator.h"
+#include "packet/wavefront_integrator.h"
 #include "renderer/render.h"
 
 #include <unistd.h>
@@ -31,6 +31,7 @@ struct RenderArgs {
   uint64_t firstSample = 0;
   std::string sampler;
   std::string strategy;
+  std::string kernel = "wavefront";
   std::string env;
   bool quiet = false;
 };
@@ -100,7 +101,7 @@ int runRender(const RenderArgs& a) {
   const double loadSeconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - loadStart).count();
 
-  const PathIntegrator integrator(s);
+  const std::unique_ptr<Integrator> integrator = makeIntegrator(s, *parseKernel(a.kernel));
   Film film(s.width, s.height);
   RenderOptions options;
   options.spp = s.spp;
@@ -109,7 +110,7 @@ int runRender(const RenderArgs& a) {
   options.firstSample = a.firstSample;
   options.sampler = s.sampler;
   options.progress = !a.quiet;
-  const RenderStats stats = render(scene, integrator, options, film);
+  const RenderStats stats = render(scene, *integrator, options, film);
 
   const Image image = film.mean();
   const Metadata meta{{"ember:scene", a.scene},
@@ -179,6 +180,10 @@ Runner addRenderCommand(CLI::App& app) {
          "vertex; emitters seen by the camera or through mirrors and glass still count); "
          "default: the scene's render.strategy")
       ->check(CLI::IsMember({"mis", "bsdf", "light"}));
+  cmd->add_option("--kernel", args->kernel,
+                  "How paths are traced, all giving the same image: wavefront (16-wide Embree packets, the "
+                  "default), stream (Embree ray streams) or scalar (one ray at a time, the reference)")
+      ->check(CLI::IsMember({"wavefront", "stream", "scalar"}));
   cmd->add_option("--env", args->env,
                   "Environment light: r,g,b (or one number) for a constant colour, or an equirectangular "
                   "EXR/HDR map; replaces the scene's");

@@ -75,6 +75,11 @@ void Scene::build() {
 bool Scene::intersect(const Ray& ray, SurfaceHit& hit) const {
   RawHit raw;
   if (!accel_->intersect(ray, raw)) return false;
+  surfaceHit(ray, raw, hit);
+  return true;
+}
+
+void Scene::surfaceHit(const Ray& ray, const RawHit& raw, SurfaceHit& hit) const {
   const GeometryRecord& rec = records_[raw.geomID];
   hit.t = raw.t;
   hit.p = ray.origin + raw.t * ray.dir;
@@ -115,7 +120,6 @@ bool Scene::intersect(const Ray& ray, SurfaceHit& hit) const {
   hit.twoSidedEmission = rec.twoSidedEmission;
   if (rec.maps && rec.maps->emission && !isBlack(rec.emission))
     hit.emission *= rec.maps->emission->eval(hit.uv);
-  return true;
 }
 
 bool Scene::occluded(const Ray& ray) const {

@@ -68,6 +68,8 @@ class Scene {
   bool built() const { return accel_ != nullptr; }
 
   bool intersect(const Ray& ray, SurfaceHit& hit) const;
+  // The full record of a hit the accelerator found for `ray` (alone or in a batch).
+  void surfaceHit(const Ray& ray, const RawHit& raw, SurfaceHit& hit) const;
   // True when something blocks the ray before ray.tMax (a shadow ray from core/ray_spawn.h).
   bool occluded(const Ray& ray) const;
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Fails when a source folder includes a folder above it in the architecture.
 
-The layers, bottom-up: core <- accel <- materials <- renderer (with packet/, its SIMD tracing)
+The layers, bottom-up: core <- accel <- materials <- renderer <- packet (batched tracing)
 <- io <- app. A folder may include its own headers and those of the layers below it, never
 those above: that keeps the build a DAG and the reading order from scene file to EXR straight.
 """
@@ -9,9 +9,7 @@ import pathlib
 import re
 import sys
 
-ORDER = ["core", "accel", "materials", "packet", "renderer", "io", "app"]
-# packet/ traces batches of rays and is driven by renderer/'s wavefront loop, so renderer may
-# include it; packet itself sees only the geometry below it.
+ORDER = ["core", "accel", "materials", "renderer", "packet", "io", "app"]
 ALLOWED = {layer: set(ORDER[: i + 1]) for i, layer in enumerate(ORDER)}
 
 root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else ".")

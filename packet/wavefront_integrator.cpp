@@ -1,0 +1,119 @@
+#include "packet/wavefront_integrator.h"
+
+#include <array>
+#include <cstdint>
+
+namespace ember {
+
+namespace {
+
+// One thread's paths in flight and their ray batches, allocated on the thread's first tile and
+// reused: the bounce loop allocates nothing.
+struct Wave {
+  static constexpr size_t kSize = WavefrontIntegrator::kWaveSize;
+  struct Lane {
+    int x, y;
+    Sampler sampler{SamplerType::Independent, 0, 0, 0};
+    PathState path;
+  };
+  std::array<Lane, kSize> lanes;
+  std::array<uint16_t, kSize> active, next, shadowOwner;
+  std::array<Color, kSize> shadowContribution;
+  ClosestHitBatch closest{kSize};
+  ShadowBatch shadows{kSize};
+};
+
+Wave& threadWave() {
+  thread_local std::unique_ptr<Wave> wave;
+  if (!wave) wave = std::make_unique<Wave>();
+  return *wave;
+}
+
+}  // namespace
+
+void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, Film& film,
+                                     PathStats& stats) const {
+  Wave& wave = threadWave();
+  const int tileWidth = work.x1 - work.x0;
+  const uint64_t pixels = uint64_t(tileWidth) * uint64_t(work.y1 - work.y0);
+  const uint64_t total = pixels * uint64_t(work.spp);
+  const uint64_t width = uint64_t(film.width());
+
+  // Camera samples are taken sample index by sample index, each over all of the tile's pixels.
+  for (uint64_t first = 0; first < total; first += Wave::kSize) {
+    const size_t count = size_t(std::min<uint64_t>(Wave::kSize, total - first));
+    size_t active = 0;
+    for (size_t i = 0; i < count; ++i) {
+      const uint64_t k = first + i;
+      const uint64_t s = k / pixels, inTile = k % pixels;
+      Wave::Lane& lane = wave.lanes[i];
+      lane.x = work.x0 + int(inTile % uint64_t(tileWidth));
+      lane.y = work.y0 + int(inTile / uint64_t(tileWidth));
+      lane.sampler = Sampler(work.sampler, work.seed, uint64_t(lane.y) * width + uint64_t(lane.x),
+                             work.firstSample + s);
+      if (path_.start(cameraRay(scene, lane.x, lane.y, lane.sampler), lane.path))
+        wave.active[active++] = uint16_t(i);
+    }
+
+    while (active > 0) {
+      wave.closest.clear();
+      for (size_t a = 0; a < active; ++a) wave.closest.push(wave.lanes[wave.active[a]].path.ray);
+      stats.rays += active;
+      wave.closest.trace(scene.accel(), traversal_);
+
+      wave.shadows.clear();
+      size_t next = 0;
+      for (size_t a = 0; a < active; ++a) {
+        Wave::Lane& lane = wave.lanes[wave.active[a]];
+        RawHit raw;
+        if (!wave.closest.hit(a, raw)) {
+          path_.onMiss(scene, lane.path);
+          continue;
+        }
+        SurfaceHit hit;
+        scene.surfaceHit(lane.path.ray, raw, hit);
+        ShadowRequest shadow;
+        bool continues;
+        if (path_.onHit(scene, lane.path, hit, lane.sampler, stats, shadow, continues)) {
+          wave.shadowOwner[wave.shadows.size()] = wave.active[a];
+          wave.shadowContribution[wave.shadows.size()] = shadow.contribution;
+          wave.shadows.push(shadow.ray);
+        }
+        if (continues) wave.next[next++] = wave.active[a];
+      }
+
+      wave.shadows.trace(scene.accel(), traversal_);
+      for (size_t j = 0; j < wave.shadows.size(); ++j)
+        if (!wave.shadows.occluded(j)) wave.lanes[wave.shadowOwner[j]].path.radiance += wave.shadowContribution[j];
+      std::swap(wave.active, wave.next);
+      active = next;
+    }
+
+    for (size_t i = 0; i < count; ++i) addToFilm(film, wave.lanes[i].x, wave.lanes[i].y, wave.lanes[i].path.radiance, stats);
+  }
+}
+
+}  // namespace ember
+
+namespace ember {
+
+std::optional<Kernel> parseKernel(std::string_view name) {
+  if (name == "wavefront") return Kernel::Wavefront;
+  if (name == "stream") return Kernel::Stream;
+  if (name == "scalar") return Kernel::Scalar;
+  return std::nullopt;
+}
+
+std::unique_ptr<Integrator> makeIntegrator(const RenderSettings& settings, Kernel kernel) {
+  switch (kernel) {
+    case Kernel::Scalar:
+      return std::make_unique<PathIntegrator>(settings);
+    case Kernel::Stream:
+      return std::make_unique<WavefrontIntegrator>(settings, BatchTraversal::Stream);
+    case Kernel::Wavefront:
+      break;
+  }
+  return std::make_unique<WavefrontIntegrator>(settings, BatchTraversal::Packets);
+}
+
+}  // namespace ember

@@ -1,0 +1,52 @@
+// The path tracer run as a wavefront: a tile's camera samples advance together, one bounce at a
+// time, and each bounce casts all their closest-hit rays, then all their shadow rays, as batches
+// of 16-wide Embree packets (packet/ray_batch.h). Between the casts every path takes exactly the
+// steps PathIntegrator::Li takes (PathIntegrator::onHit, onMiss), with its own sampler, and a
+// pixel's samples reach the film in the order of their indices, so the image equals the scalar
+// reference's bit for bit (tests/test_wavefront.cpp) and is the same for any thread count.
+#pragma once
+
+#include "packet/ray_batch.h"
+#include "renderer/path_integrator.h"
+
+namespace ember {
+
+class WavefrontIntegrator final : public Integrator {
+ public:
+  // Paths in flight per wave: a 16x16 tile's pixels at one sample index.
+  static constexpr size_t kWaveSize = 256;
+
+  explicit WavefrontIntegrator(const RenderSettings& s, BatchTraversal traversal = BatchTraversal::Packets)
+      : path_(s), traversal_(traversal) {}
+  WavefrontIntegrator(const PathIntegrator& path, BatchTraversal traversal = BatchTraversal::Packets)
+      : path_(path), traversal_(traversal) {}
+
+  Color Li(const Scene& scene, Ray ray, Sampler& sampler, PathStats& stats) const override {
+    return path_.Li(scene, ray, sampler, stats);
+  }
+  void renderTile(const Scene& scene, const TileWork& work, Film& film, PathStats& stats) const override;
+
+ private:
+  PathIntegrator path_;
+  BatchTraversal traversal_;
+};
+
+}  // namespace ember
+
+#include <memory>
+#include <optional>
+#include <string_view>
+
+namespace ember {
+
+// How `render` and `bench` run the path tracer (--kernel). All give the same image bit for bit;
+// they differ in speed (docs/performance.md).
+//  - wavefront: WavefrontIntegrator with one rtcIntersect16 / rtcOccluded16 call per packet;
+//  - stream:    WavefrontIntegrator handing each batch to Embree as one ray stream;
+//  - scalar:    PathIntegrator::Li, one ray at a time (the reference implementation).
+enum class Kernel { Wavefront, Stream, Scalar };
+inline constexpr const char* kKernelNames = "wavefront, stream, scalar";
+std::optional<Kernel> parseKernel(std::string_view name);
+std::unique_ptr<Integrator> makeIntegrator(const RenderSettings& settings, Kernel kernel);
+
+}  // namespace ember
