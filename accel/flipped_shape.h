@@ -19,6 +19,12 @@ class FlippedShape final : public Shape {
     hit.ng = -hit.ng;
     return true;
   }
+  uint32_t candidateLanes(const RayLanes& rays) const override { return inner_->candidateLanes(rays); }
+  Vec2 surfaceUv(const LocalHit& hit) const override {
+    LocalHit original = hit;
+    original.ng = -hit.ng;
+    return inner_->surfaceUv(original);
+  }
   SurfacePoint projectToSurface(const Vec3& p, const LocalHit& hit) const override {
     LocalHit original = hit;
     original.ng = -hit.ng;

@@ -2,6 +2,13 @@
 
 namespace ember {
 
+uint32_t Shape::candidateLanes(const RayLanes& rays) const {
+  uint32_t bits = 0;
+  for (unsigned i = 0; i < rays.n; ++i)
+    if (rays.valid[i] == -1) bits |= 1u << i;
+  return bits;
+}
+
 float areaToSolidAnglePdf(float pdfArea, const Vec3& ref, const Vec3& p, const Vec3& n) {
   const Vec3 d = p - ref;
   const float dist2 = glm::dot(d, d);

@@ -4,6 +4,7 @@
 // "front" side, the side an emitting shape emits on.
 #pragma once
 
+#include "accel/shape_lanes.h"
 #include "core/math.h"
 #include "core/ray_spawn.h"
 
@@ -54,6 +55,16 @@ class Shape {
 
   // Closest hit with t in (tMin, tMax); false when there is none.
   virtual bool intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const = 0;
+
+  // The live lanes of an Embree packet that may hit the shape (bit i for lane i); intersect()
+  // decides each of them. Shapes with a SIMD filter (accel/shape_lanes.h) clear the bits of
+  // lanes that certainly miss; the default keeps every live lane.
+  virtual uint32_t candidateLanes(const RayLanes& rays) const;
+
+  // The texture coordinates of a hit that intersect() reported. Shapes whose UV needs more than
+  // the closest hit's parameters (the sphere's inverse trigonometry) compute it here, once for
+  // the hit that counts rather than for every candidate Embree tests.
+  virtual Vec2 surfaceUv(const LocalHit& hit) const { return hit.uv; }
 
   // Moves a hit point p = o + t d, which float rounding of t leaves up to ~ulp(t) off the surface,
   // onto the surface as intersect() sees it (computed in double from the same float parameters),

@@ -12,7 +12,8 @@ Bounds Sphere::bounds() const {
   return b;
 }
 
-static Vec2 sphereUv(const Vec3& n) {
+Vec2 Sphere::surfaceUv(const LocalHit& hit) const {
+  const Vec3& n = hit.ng;
   const float u = 0.5f + std::atan2(n.x, n.z) / (2.0f * kPi);
   const float v = std::acos(std::clamp(n.y, -1.0f, 1.0f)) * kInvPi;
   return {u, v};
@@ -35,7 +36,6 @@ bool Sphere::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) co
   const glm::dvec3 local = oc + t * d;
   hit.t = float(t);
   hit.ng = Vec3(glm::normalize(local));
-  hit.uv = sphereUv(hit.ng);
   return true;
 }
 

@@ -41,6 +41,7 @@ Triangle::Triangle(const std::array<Vec3, 3>& v, const std::array<Vec2, 3>& uv)
       uv_(uv),
       normal_(frontNormal(v[0], v[1], v[2])),
       plane_(DoublePlane::through(v[0], v[1], v[2])),
+      filter_(TriangleFilter::of(v[0], v[1], v[2], plane_)),
       area_(triangleArea(v[0], v[1], v[2])) {}
 
 Bounds Triangle::bounds() const {
@@ -112,6 +113,8 @@ Quad::Quad(const std::array<Vec3, 4>& v, const std::array<Vec2, 4>& uv)
   // A degenerate half (a quad given as a triangle, v3 = v0) has no plane of its own.
   if (!(area1_ > 0.0f)) planes_[1] = planes_[0];
   if (!(area0_ > 0.0f)) planes_[0] = planes_[1];
+  filters_[0] = TriangleFilter::of(v[0], v[1], v[2], planes_[0]);
+  filters_[1] = TriangleFilter::of(v[0], v[2], v[3], planes_[1]);
 }
 
 Bounds Quad::bounds() const {

@@ -24,6 +24,7 @@ class Triangle final : public Shape {
   std::string_view typeName() const override { return "triangle"; }
   Bounds bounds() const override;
   bool intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const override;
+  uint32_t candidateLanes(const RayLanes& rays) const override { return triangleCandidates(rays, filter_); }
   SurfacePoint projectToSurface(const Vec3& p, const LocalHit&) const override { return plane_.project(p); }
   float area() const override { return area_; }
   ShapeSample sampleArea(Vec2 u) const override;
@@ -36,6 +37,7 @@ class Triangle final : public Shape {
   std::array<Vec2, 3> uv_;
   Vec3 normal_;
   DoublePlane plane_;
+  TriangleFilter filter_;
   float area_;
 };
 
@@ -46,6 +48,9 @@ class Quad final : public Shape {
   std::string_view typeName() const override { return "quad"; }
   Bounds bounds() const override;
   bool intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const override;
+  uint32_t candidateLanes(const RayLanes& rays) const override {
+    return triangleCandidates(rays, filters_[0]) | triangleCandidates(rays, filters_[1]);
+  }
   // Onto the plane of the half (v0, v1, v2) or (v0, v2, v3) that p lies over: a quad's four
   // vertices need only be coplanar to 1e-4 of its size.
   SurfacePoint projectToSurface(const Vec3& p, const LocalHit& hit) const override;
@@ -60,7 +65,8 @@ class Quad final : public Shape {
   std::array<Vec3, 4> v_;
   std::array<Vec2, 4> uv_;
   Vec3 normal_;
-  DoublePlane planes_[2];  // of the halves (v0,v1,v2) and (v0,v2,v3)
+  DoublePlane planes_[2];       // of the halves (v0,v1,v2) and (v0,v2,v3)
+  TriangleFilter filters_[2];  // of the same halves
   float area0_, area1_;    // of (v0,v1,v2) and (v0,v2,v3)
 };
 

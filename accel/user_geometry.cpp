@@ -2,6 +2,8 @@
 
 #include "accel/shape.h"
 
+#include <algorithm>
+
 namespace ember {
 
 void shapeBoundsCallback(const RTCBoundsFunctionArguments* args) {
@@ -18,45 +20,101 @@ void shapeBoundsCallback(const RTCBoundsFunctionArguments* args) {
   out->upper_z = b.upper.z + pad.z;
 }
 
-static Ray rayOf(RTCRayN* rays, unsigned n, unsigned i) {
-  Ray r;
-  r.origin = Vec3(RTCRayN_org_x(rays, n, i), RTCRayN_org_y(rays, n, i), RTCRayN_org_z(rays, n, i));
-  r.dir = Vec3(RTCRayN_dir_x(rays, n, i), RTCRayN_dir_y(rays, n, i), RTCRayN_dir_z(rays, n, i));
-  r.tMax = RTCRayN_tfar(rays, n, i);
-  return r;
+// A ray packet in Embree's RTCRayN layout (each field an array of N floats, in RTCRay's order),
+// in blocks of RayLanes::kMaxLanes lanes for the shapes' lane filters. Packets of other widths
+// (Embree only sends 16 or 1 here, as Ember casts rtcIntersect16 and rtcIntersect1) are copied
+// into a padded block, so a filter never reads past an array.
+class PacketLanes {
+ public:
+  PacketLanes(RTCRayN* rays, unsigned n, const int* valid) : f_(reinterpret_cast<float*>(rays)), n_(n), valid_(valid) {}
+
+  unsigned blocks() const { return (n_ + RayLanes::kMaxLanes - 1) / RayLanes::kMaxLanes; }
+  RayLanes block(unsigned k) {
+    const unsigned first = k * RayLanes::kMaxLanes;
+    const unsigned count = std::min(RayLanes::kMaxLanes, n_ - first);
+    if (n_ % RayLanes::kMaxLanes == 0) {
+      auto field = [&](unsigned i) { return f_ + i * n_ + first; };
+      return RayLanes{{field(0), field(1), field(2)}, {field(4), field(5), field(6)}, field(3), field(8), valid_ + first, count};
+    }
+    for (unsigned i = 0; i < RayLanes::kMaxLanes; ++i) {
+      const bool in = i < count;
+      for (unsigned c = 0; c < 3; ++c) {
+        pad_.org[c][i] = in ? f_[c * n_ + first + i] : 0.0f;
+        pad_.dir[c][i] = in ? f_[(4 + c) * n_ + first + i] : 0.0f;
+      }
+      pad_.tnear[i] = in ? f_[3 * n_ + first + i] : 0.0f;
+      pad_.tfar[i] = in ? f_[8 * n_ + first + i] : 0.0f;
+      pad_.valid[i] = in ? valid_[first + i] : 0;
+    }
+    return RayLanes{{pad_.org[0], pad_.org[1], pad_.org[2]}, {pad_.dir[0], pad_.dir[1], pad_.dir[2]}, pad_.tnear, pad_.tfar, pad_.valid, count};
+  }
+  Ray ray(unsigned i) const {
+    Ray r;
+    r.origin = Vec3(f_[i], f_[n_ + i], f_[2 * n_ + i]);
+    r.dir = Vec3(f_[4 * n_ + i], f_[5 * n_ + i], f_[6 * n_ + i]);
+    r.tMax = f_[8 * n_ + i];
+    return r;
+  }
+  float tnear(unsigned i) const { return f_[3 * n_ + i]; }
+
+ private:
+  struct Padded {
+    alignas(64) float org[3][RayLanes::kMaxLanes];
+    alignas(64) float dir[3][RayLanes::kMaxLanes];
+    alignas(64) float tnear[RayLanes::kMaxLanes];
+    alignas(64) float tfar[RayLanes::kMaxLanes];
+    alignas(64) int valid[RayLanes::kMaxLanes];
+  };
+  float* f_;
+  unsigned n_;
+  const int* valid_;
+  Padded pad_;
+};
+
+// Calls report(lane, hit) for each live lane of the packet that hits the shape. The shape's lane
+// filter (accel/shape_lanes.h) drops the lanes that certainly miss; the scalar routine decides
+// the rest, so a packet finds the hits single rays find. Single rays go straight to it.
+template <typename Report>
+void intersectPacket(const Shape& shape, RTCRayN* rays, unsigned n, const int* valid, Report report) {
+  PacketLanes packet(rays, n, valid);
+  if (n == 1) {
+    LocalHit h;
+    if (valid[0] == -1 && shape.intersect(packet.ray(0), packet.tnear(0), packet.ray(0).tMax, h)) report(0u, h);
+    return;
+  }
+  for (unsigned k = 0; k < packet.blocks(); ++k) {
+    for (uint32_t bits = shape.candidateLanes(packet.block(k)); bits != 0; bits &= bits - 1) {
+      const unsigned i = k * RayLanes::kMaxLanes + unsigned(__builtin_ctz(bits));
+      const Ray ray = packet.ray(i);
+      LocalHit h;
+      if (shape.intersect(ray, packet.tnear(i), ray.tMax, h)) report(i, h);
+    }
+  }
 }
 
 void shapeIntersectCallback(const RTCIntersectFunctionNArguments* args) {
   const auto* shape = static_cast<const Shape*>(args->geometryUserPtr);
   RTCRayN* rays = RTCRayHitN_RayN(args->rayhit, args->N);
   RTCHitN* hits = RTCRayHitN_HitN(args->rayhit, args->N);
-  for (unsigned i = 0; i < args->N; ++i) {
-    if (args->valid[i] != -1) continue;
-    const Ray ray = rayOf(rays, args->N, i);
-    LocalHit h;
-    if (!shape->intersect(ray, RTCRayN_tnear(rays, args->N, i), ray.tMax, h)) continue;
-    RTCRayN_tfar(rays, args->N, i) = h.t;
-    RTCHitN_Ng_x(hits, args->N, i) = h.ng.x;
-    RTCHitN_Ng_y(hits, args->N, i) = h.ng.y;
-    RTCHitN_Ng_z(hits, args->N, i) = h.ng.z;
-    RTCHitN_u(hits, args->N, i) = h.uv.x;
-    RTCHitN_v(hits, args->N, i) = h.uv.y;
-    RTCHitN_primID(hits, args->N, i) = args->primID;
-    RTCHitN_geomID(hits, args->N, i) = args->geomID;
-    RTCHitN_instID(hits, args->N, i, 0) = args->context->instID[0];
-  }
+  const unsigned n = args->N;
+  intersectPacket(*shape, rays, n, args->valid, [&](unsigned i, const LocalHit& h) {
+    RTCRayN_tfar(rays, n, i) = h.t;
+    RTCHitN_Ng_x(hits, n, i) = h.ng.x;
+    RTCHitN_Ng_y(hits, n, i) = h.ng.y;
+    RTCHitN_Ng_z(hits, n, i) = h.ng.z;
+    RTCHitN_u(hits, n, i) = h.uv.x;
+    RTCHitN_v(hits, n, i) = h.uv.y;
+    RTCHitN_primID(hits, n, i) = args->primID;
+    RTCHitN_geomID(hits, n, i) = args->geomID;
+    RTCHitN_instID(hits, n, i, 0) = args->context->instID[0];
+  });
 }
 
 void shapeOccludedCallback(const RTCOccludedFunctionNArguments* args) {
   const auto* shape = static_cast<const Shape*>(args->geometryUserPtr);
-  for (unsigned i = 0; i < args->N; ++i) {
-    if (args->valid[i] != -1) continue;
-    const Ray ray = rayOf(args->ray, args->N, i);
-    LocalHit h;
-    // Embree 3 reports an occluded ray by setting tfar to -infinity.
-    if (shape->intersect(ray, RTCRayN_tnear(args->ray, args->N, i), ray.tMax, h))
-      RTCRayN_tfar(args->ray, args->N, i) = -kInfinity;
-  }
+  // Embree 3 reports an occluded ray by setting tfar to -infinity.
+  intersectPacket(*shape, args->ray, args->N, args->valid,
+                  [&](unsigned i, const LocalHit&) { RTCRayN_tfar(args->ray, args->N, i) = -kInfinity; });
 }
 
 }  // namespace ember

@@ -91,8 +91,8 @@ void Scene::surfaceHit(const Ray& ray, const RawHit& raw, SurfaceHit& hit) const
   // projection costs ~5% of a render.)
   if (rec.shape) {
     hit.ng = raw.ng;
-    hit.uv = raw.uv;
-    LocalHit local{raw.t, raw.ng, raw.uv};
+    const LocalHit local{raw.t, raw.ng, raw.uv};
+    hit.uv = rec.shape->surfaceUv(local);
     const float magnitude = maxComponent(glm::abs(hit.p));
     if (raw.t > magnitude) {
       const SurfacePoint onSurface = rec.shape->projectToSurface(hit.p, local);

@@ -87,8 +87,9 @@ void expectHit(const Shape& shape, const Ray& ray, float t, const Vec3& n, std::
   EXPECT_NEAR(hit.t, t, tol) << shape.typeName();
   expectVecNear(hit.ng, glm::normalize(n), kFloatTol * 4.0f, std::string(shape.typeName()) + " normal");
   if (uv) {
-    EXPECT_NEAR(hit.uv.x, uv->x, kFloatTol * 4.0f) << shape.typeName() << " u";
-    EXPECT_NEAR(hit.uv.y, uv->y, kFloatTol * 4.0f) << shape.typeName() << " v";
+    const Vec2 st = shape.surfaceUv(hit);
+    EXPECT_NEAR(st.x, uv->x, kFloatTol * 4.0f) << shape.typeName() << " u";
+    EXPECT_NEAR(st.y, uv->y, kFloatTol * 4.0f) << shape.typeName() << " v";
   }
 }
 
@@ -106,7 +107,8 @@ void expectGrazingSane(const Shape& shape, const Ray& ray, float tExpected, floa
   EXPECT_TRUE(std::isfinite(hit.t)) << shape.typeName();
   EXPECT_NEAR(hit.t, tExpected, tSlack) << shape.typeName();
   EXPECT_NEAR(glm::length(hit.ng), 1.0f, kFloatTol) << shape.typeName();
-  EXPECT_TRUE(std::isfinite(hit.uv.x) && std::isfinite(hit.uv.y)) << shape.typeName();
+  const Vec2 st = shape.surfaceUv(hit);
+  EXPECT_TRUE(std::isfinite(st.x) && std::isfinite(st.y)) << shape.typeName();
 }
 
 // Rotation by `angle` about the unit `axis` (Rodrigues), as a local -> world matrix.

@@ -1,0 +1,198 @@
+// Compiled once per SIMD target by Highway's foreach_target.h; see accel/shape_lanes.h.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "accel/shape_lanes.cpp"
+#include <hwy/foreach_target.h>  // must come before highway.h
+#include <hwy/highway.h>
+
+#include "accel/shape.h"
+#include "accel/shape_lanes.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace ember::HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+using D = hn::ScalableTag<float>;
+using V = hn::Vec<D>;
+using M = hn::Mask<D>;
+
+constexpr float kEps = 0x1p-24f;
+// gamma(n), rounded up generously: every bound below is multiplied by these, never trusted to
+// the last ulp.
+constexpr float gamma(int n) {
+  return 1.01f * float(n) * kEps / (1.0f - float(n) * kEps);
+}
+
+struct Vec3V {
+  V x, y, z;
+};
+
+HWY_INLINE V dot(const Vec3V& a, const Vec3V& b) {
+  return hn::MulAdd(a.z, b.z, hn::MulAdd(a.y, b.y, hn::Mul(a.x, b.x)));
+}
+HWY_INLINE V absDot(D /*d*/, const Vec3V& a, const Vec3V& b) {
+  return hn::MulAdd(hn::Abs(a.z), hn::Abs(b.z), hn::MulAdd(hn::Abs(a.y), hn::Abs(b.y), hn::Mul(hn::Abs(a.x), hn::Abs(b.x))));
+}
+HWY_INLINE V maxAbs(const Vec3V& a) {
+  return hn::Max(hn::Abs(a.x), hn::Max(hn::Abs(a.y), hn::Abs(a.z)));
+}
+HWY_INLINE Vec3V splat(D d, const Vec3& v) {
+  return {hn::Set(d, v.x), hn::Set(d, v.y), hn::Set(d, v.z)};
+}
+
+struct LaneBlock {
+  Vec3V o, dir;
+  V tMin, tMax;
+  M live;
+};
+
+HWY_INLINE LaneBlock loadBlock(D d, const RayLanes& r, unsigned i) {
+  const hn::RebindToSigned<D> di;
+  LaneBlock b;
+  b.o = {hn::LoadU(d, r.org[0] + i), hn::LoadU(d, r.org[1] + i), hn::LoadU(d, r.org[2] + i)};
+  b.dir = {hn::LoadU(d, r.dir[0] + i), hn::LoadU(d, r.dir[1] + i), hn::LoadU(d, r.dir[2] + i)};
+  b.tMin = hn::LoadU(d, r.tnear + i);
+  b.tMax = hn::LoadU(d, r.tfar + i);
+  b.live = hn::RebindMask(d, hn::Eq(hn::LoadU(di, r.valid + i), hn::Set(di, -1)));
+  return b;
+}
+
+HWY_INLINE uint32_t maskBits(D d, M m) {
+  uint8_t bytes[8] = {};
+  hn::StoreMaskBits(d, m, bytes);
+  uint32_t bits = 0;
+  for (size_t k = 0; k < (hn::Lanes(d) + 7) / 8; ++k) bits |= uint32_t(bytes[k]) << (8 * k);
+  return bits;
+}
+
+// The rays are read in blocks of Lanes(d); RayLanes arrays hold kMaxLanes entries, so a block
+// never reads past them, and lanes at or beyond n are not live.
+template <typename Block>
+HWY_INLINE uint32_t forEachBlock(D d, const RayLanes& rays, Block block) {
+  const unsigned step = unsigned(hn::Lanes(d));
+  uint32_t bits = 0;
+  for (unsigned i = 0; i < rays.n; i += step) {
+    const LaneBlock b = loadBlock(d, rays, i);
+    if (hn::AllFalse(d, b.live)) continue;
+    bits |= maskBits(d, hn::And(b.live, block(b))) << i;
+  }
+  const uint32_t inRange = rays.n >= 32 ? ~0u : (1u << rays.n) - 1u;
+  return bits & inRange;
+}
+
+uint32_t TriangleCandidates(const RayLanes& rays, const TriangleFilter& tri) {
+  const D d;
+  const Vec3V n = splat(d, tri.n), v0 = splat(d, tri.v0), g1 = splat(d, tri.g1), g2 = splat(d, tri.g2);
+  const V planeD = hn::Set(d, tri.d), planeError = hn::Set(d, tri.planeError);
+  const V v0Max = hn::Set(d, tri.v0Max), g1Sum = hn::Set(d, tri.g1Sum), g2Sum = hn::Set(d, tri.g2Sum);
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0f);
+  return forEachBlock(d, rays, [&](const LaneBlock& b) {
+    // The plane: t = (d - n.o) / (n.dir). With num = num_f + a and den = den_f + b the exact t
+    // differs from num_f / den_f by at most (|a| + |t| |b|) / (|den_f| - |b|), plus the division's
+    // rounding.
+    const V den = dot(n, b.dir);
+    const V denError = hn::Mul(hn::Set(d, gamma(4)), absDot(d, n, b.dir));
+    const V num = hn::Sub(planeD, dot(n, b.o));
+    const V numError = hn::MulAdd(hn::Set(d, gamma(5)), hn::Add(hn::Abs(planeD), absDot(d, n, b.o)),
+                                  hn::Mul(planeError, hn::Add(one, maxAbs(b.o))));
+    const V t = hn::Div(num, den);
+    const V absT = hn::Abs(t);
+    const V slack = hn::Sub(hn::Abs(den), denError);
+    const V tError = hn::MulAdd(hn::Set(d, 4.0f * kEps), absT,
+                                hn::Mul(hn::Set(d, 1.1f), hn::Div(hn::MulAdd(absT, denError, numError), slack)));
+    // Only certain verdicts count: a lane whose bound is not finite, or whose denominator may be
+    // zero, stays a candidate (every comparison with NaN is false).
+    const M planeMiss = hn::And(hn::Gt(slack, zero), hn::Or(hn::Le(hn::Add(t, tError), b.tMin),
+                                                            hn::Ge(hn::Sub(t, tError), b.tMax)));
+    // The barycentrics of p = o + t dir, which is within pError of the plane's exact point in
+    // each coordinate; b = dot(p - v0, g) then has error <= sum|g_i| (pError + rounding).
+    const Vec3V p{hn::MulAdd(t, b.dir.x, b.o.x), hn::MulAdd(t, b.dir.y, b.o.y), hn::MulAdd(t, b.dir.z, b.o.z)};
+    const Vec3V rel{hn::Sub(p.x, v0.x), hn::Sub(p.y, v0.y), hn::Sub(p.z, v0.z)};
+    const V pError = hn::MulAdd(tError, maxAbs(b.dir),
+                                hn::Mul(hn::Set(d, gamma(3)), hn::Add(hn::Add(maxAbs(b.o), hn::Mul(absT, maxAbs(b.dir))),
+                                                                      hn::Add(v0Max, maxAbs(rel)))));
+    const V b1 = dot(rel, g1), b2 = dot(rel, g2);
+    const V b1Error = hn::MulAdd(g1Sum, pError, hn::Mul(hn::Set(d, gamma(4)), absDot(d, rel, g1)));
+    const V b2Error = hn::MulAdd(g2Sum, pError, hn::Mul(hn::Set(d, gamma(4)), absDot(d, rel, g2)));
+    const M outside = hn::Or(hn::Or(hn::Lt(hn::Add(b1, b1Error), zero), hn::Lt(hn::Add(b2, b2Error), zero)),
+                             hn::Gt(hn::Sub(hn::Add(b1, b2), hn::Add(hn::Add(b1Error, b2Error), hn::Set(d, gamma(2)))), one));
+    const M certainMiss = hn::Or(planeMiss, hn::And(hn::Gt(slack, zero), outside));
+    return hn::Not(certainMiss);
+  });
+}
+
+uint32_t SphereCandidates(const RayLanes& rays, const Vec3& center, float radius) {
+  const D d;
+  const Vec3V c = splat(d, center);
+  const V cMax = hn::Set(d, maxComponent(glm::abs(center)));
+  const V r2 = hn::Set(d, radius * radius);
+  return forEachBlock(d, rays, [&](const LaneBlock& b) {
+    // disc = (oc.dir)^2 - |dir|^2 (|oc|^2 - r^2), the sign of solveQuadratic's discriminant / 4.
+    // Each oc_i = o_i - c_i is off by <= eps (|o_i| + |c_i|) =: e; the products and sums add
+    // gamma-sized relative errors of the absolute values.
+    const Vec3V oc{hn::Sub(b.o.x, c.x), hn::Sub(b.o.y, c.y), hn::Sub(b.o.z, c.z)};
+    const V e = hn::Mul(hn::Set(d, gamma(1)), hn::Add(maxAbs(b.o), cMax));
+    const V dirSum = hn::Add(hn::Add(hn::Abs(b.dir.x), hn::Abs(b.dir.y)), hn::Abs(b.dir.z));
+    const V ocSum = hn::Add(hn::Add(hn::Abs(oc.x), hn::Abs(oc.y)), hn::Abs(oc.z));
+    const V bb = dot(oc, b.dir);
+    const V bError = hn::MulAdd(hn::Set(d, gamma(4)), absDot(d, oc, b.dir), hn::Mul(hn::Set(d, 1.01f), hn::Mul(e, dirSum)));
+    const V a = dot(b.dir, b.dir);
+    const V aError = hn::Mul(hn::Set(d, gamma(4)), a);
+    const V ocLen2 = dot(oc, oc);
+    const V cc = hn::Sub(ocLen2, r2);
+    const V cError = hn::MulAdd(hn::Set(d, gamma(5)), hn::Add(ocLen2, r2),
+                                hn::MulAdd(hn::Set(d, 3.03f), hn::Mul(e, e), hn::Mul(hn::Set(d, 2.02f), hn::Mul(e, ocSum))));
+    const V disc = hn::Sub(hn::Mul(bb, bb), hn::Mul(a, cc));
+    const V absB = hn::Abs(bb), absC = hn::Abs(cc);
+    const V discError = hn::Mul(
+        hn::Set(d, 1.1f),
+        hn::Add(hn::Add(hn::MulAdd(hn::Set(d, 2.0f), hn::Mul(absB, bError), hn::Mul(bError, bError)),
+                        hn::MulAdd(a, cError, hn::Mul(absC, aError))),
+                hn::MulAdd(aError, cError, hn::Mul(hn::Set(d, gamma(3)), hn::MulAdd(absB, absB, hn::Mul(a, absC))))));
+    return hn::Not(hn::Lt(hn::Add(disc, discError), hn::Zero(d)));
+  });
+}
+
+}  // namespace ember::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace ember {
+
+HWY_EXPORT(TriangleCandidates);
+HWY_EXPORT(SphereCandidates);
+
+TriangleFilter TriangleFilter::of(const Vec3& v0, const Vec3& v1, const Vec3& v2, const DoublePlane& plane) {
+  TriangleFilter f;
+  const glm::dvec3 p0(v0), e1 = glm::dvec3(v1) - p0, e2 = glm::dvec3(v2) - p0;
+  const glm::dvec3 normal = glm::cross(e1, e2);
+  const double len2 = glm::dot(normal, normal);
+  f.v0 = v0;
+  f.v0Max = maxComponent(glm::abs(v0));
+  f.n = Vec3(plane.n);
+  f.d = float(plane.d);
+  // float(d) and float(n) are each within eps of the double values: |d| eps + |n|_1 eps |o|,
+  // the second part scaled by max|o| in the kernel.
+  f.planeError = 2.0f * 0x1p-24f * std::max(std::abs(f.d), 1.0f);
+  if (len2 > 0.0) {
+    f.g1 = Vec3(glm::cross(e2, normal) / len2);
+    f.g2 = Vec3(glm::cross(normal, e1) / len2);
+  } else {
+    // A degenerate triangle: the scalar test never hits it; NaN keeps every lane a candidate.
+    f.g1 = f.g2 = Vec3(std::numeric_limits<float>::quiet_NaN());
+  }
+  // The dual vectors' own rounding adds eps |g| to the error of b, counted in the sums.
+  f.g1Sum = 1.01f * (std::abs(f.g1.x) + std::abs(f.g1.y) + std::abs(f.g1.z));
+  f.g2Sum = 1.01f * (std::abs(f.g2.x) + std::abs(f.g2.y) + std::abs(f.g2.z));
+  return f;
+}
+
+uint32_t triangleCandidates(const RayLanes& rays, const TriangleFilter& tri) {
+  return HWY_DYNAMIC_DISPATCH(TriangleCandidates)(rays, tri);
+}
+
+uint32_t sphereCandidates(const RayLanes& rays, const Vec3& center, float radius) {
+  return HWY_DYNAMIC_DISPATCH(SphereCandidates)(rays, center, radius);
+}
+
+}  // namespace ember
+#endif

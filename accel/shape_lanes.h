@@ -1,0 +1,57 @@
+// Many rays against one shape at once, for Embree's packet callbacks (accel/user_geometry.cpp):
+// Embree hands a user geometry the rays of a 16-wide packet that reached its leaf, with a mask of
+// the live ones. A lane filter runs a float version of the shape's test on all of them together
+// (Highway vectors, 16 floats per AVX-512 register; the widest ISA the CPU has is picked at run
+// time by HWY_DYNAMIC_DISPATCH) and carries a conservative bound on its rounding error, so it
+// rejects only rays that certainly miss. The few that may hit are then intersected by the shape's
+// scalar, double-precision routine. The filter decides nothing else, so a packet finds exactly
+// the hits single rays find, bit for bit (tests/test_shape_lanes.cpp), and the robustness of the
+// double-precision routines (no acne, no leaks at grazing angles) carries over unchanged.
+//
+// Error bounds follow the standard model fl(a op b) = (a op b)(1 + d), |d| <= eps = 2^-24, and
+// gamma(n) = n eps / (1 - n eps) for sums and dot products of n terms (Higham 2002, ch. 3;
+// PBRT4 section 6.8.1).
+#pragma once
+
+#include "core/math.h"
+
+#include <cstdint>
+
+namespace ember {
+
+struct DoublePlane;
+
+// Up to kMaxLanes rays in Embree's RTCRayN layout: lane i of each array.
+struct RayLanes {
+  static constexpr unsigned kMaxLanes = 16;
+  const float* org[3];
+  const float* dir[3];
+  const float* tnear;
+  const float* tfar;
+  const int* valid;  // -1 = live
+  unsigned n;
+};
+
+// A triangle (v0, v1, v2) as its float filter sees it: the plane dot(n, x) = d, and the dual
+// vectors g1, g2 with b1 = dot(p - v0, g1), b2 = dot(p - v0, g2) for a point p of the plane
+// (the barycentrics of v1 and v2; Moller-Trumbore's u and v).
+struct TriangleFilter {
+  Vec3 v0{0.0f}, n{0.0f, 0.0f, 1.0f}, g1{0.0f}, g2{0.0f};
+  float d = 0.0f;
+  float v0Max = 0.0f;  // max |v0_i|
+  float g1Sum = 0.0f;  // sum |g1_i|
+  float g2Sum = 0.0f;
+  float planeError = 0.0f;  // bound on |float d - exact d| plus the rounding of n
+
+  // `plane` is the one the scalar test uses (the plane through the float vertices).
+  static TriangleFilter of(const Vec3& v0, const Vec3& v1, const Vec3& v2, const DoublePlane& plane);
+};
+
+// Bit i set: live lane i may hit the triangle (DoublePlane::crossedWithin and intersectTriangle
+// might both succeed); clear: it certainly misses.
+uint32_t triangleCandidates(const RayLanes& rays, const TriangleFilter& tri);
+
+// Bit i set: live lane i may hit the sphere (its discriminant may be >= 0).
+uint32_t sphereCandidates(const RayLanes& rays, const Vec3& center, float radius);
+
+}  // namespace ember
