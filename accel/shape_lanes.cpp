@@ -30,7 +30,8 @@ HWY_INLINE V dot(const Vec3V& a, const Vec3V& b) {
   return hn::MulAdd(a.z, b.z, hn::MulAdd(a.y, b.y, hn::Mul(a.x, b.x)));
 }
 HWY_INLINE V absDot(D /*d*/, const Vec3V& a, const Vec3V& b) {
-  return hn::MulAdd(hn::Abs(a.z), hn::Abs(b.z), hn::MulAdd(hn::Abs(a.y), hn::Abs(b.y), hn::Mul(hn::Abs(a.x), hn::Abs(b.x))));
+  return hn::MulAdd(hn::Abs(a.z), hn::Abs(b.z),
+                    hn::MulAdd(hn::Abs(a.y), hn::Abs(b.y), hn::Mul(hn::Abs(a.x), hn::Abs(b.x))));
 }
 HWY_INLINE V maxAbs(const Vec3V& a) {
   return hn::Max(hn::Abs(a.x), hn::Max(hn::Abs(a.y), hn::Abs(a.z)));
@@ -82,7 +83,7 @@ HWY_INLINE uint32_t forEachBlock(D d, const RayLanes& rays, Block block) {
 uint32_t TriangleCandidates(const RayLanes& rays, const TriangleFilter& tri) {
   const D d;
   const Vec3V n = splat(d, tri.n), v0 = splat(d, tri.v0), g1 = splat(d, tri.g1), g2 = splat(d, tri.g2);
-  const V planeD = hn::Set(d, tri.d), planeError = hn::Set(d, tri.planeError);
+  const V planeD = hn::Set(d, tri.d), dError = hn::Set(d, tri.dError);
   const V v0Max = hn::Set(d, tri.v0Max), g1Sum = hn::Set(d, tri.g1Sum), g2Sum = hn::Set(d, tri.g2Sum);
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0f);
   return forEachBlock(d, rays, [&](const LaneBlock& b) {
@@ -93,28 +94,35 @@ uint32_t TriangleCandidates(const RayLanes& rays, const TriangleFilter& tri) {
     const V denError = hn::Mul(hn::Set(d, gamma(4)), absDot(d, n, b.dir));
     const V num = hn::Sub(planeD, dot(n, b.o));
     const V numError = hn::MulAdd(hn::Set(d, gamma(5)), hn::Add(hn::Abs(planeD), absDot(d, n, b.o)),
-                                  hn::Mul(planeError, hn::Add(one, maxAbs(b.o))));
+                                  hn::MulAdd(hn::Set(d, 2.02f * kEps), maxAbs(b.o), dError));
     const V t = hn::Div(num, den);
     const V absT = hn::Abs(t);
     const V slack = hn::Sub(hn::Abs(den), denError);
-    const V tError = hn::MulAdd(hn::Set(d, 4.0f * kEps), absT,
-                                hn::Mul(hn::Set(d, 1.1f), hn::Div(hn::MulAdd(absT, denError, numError), slack)));
+    const V tError =
+        hn::MulAdd(hn::Set(d, 4.0f * kEps), absT,
+                   hn::Mul(hn::Set(d, 1.1f), hn::Div(hn::MulAdd(absT, denError, numError), slack)));
     // Only certain verdicts count: a lane whose bound is not finite, or whose denominator may be
     // zero, stays a candidate (every comparison with NaN is false).
-    const M planeMiss = hn::And(hn::Gt(slack, zero), hn::Or(hn::Le(hn::Add(t, tError), b.tMin),
-                                                            hn::Ge(hn::Sub(t, tError), b.tMax)));
+    const M planeMiss = hn::And(
+        hn::Gt(slack, zero), hn::Or(hn::Le(hn::Add(t, tError), b.tMin), hn::Ge(hn::Sub(t, tError), b.tMax)));
     // The barycentrics of p = o + t dir, which is within pError of the plane's exact point in
     // each coordinate; b = dot(p - v0, g) then has error <= sum|g_i| (pError + rounding).
-    const Vec3V p{hn::MulAdd(t, b.dir.x, b.o.x), hn::MulAdd(t, b.dir.y, b.o.y), hn::MulAdd(t, b.dir.z, b.o.z)};
+    const Vec3V p{hn::MulAdd(t, b.dir.x, b.o.x), hn::MulAdd(t, b.dir.y, b.o.y),
+                  hn::MulAdd(t, b.dir.z, b.o.z)};
     const Vec3V rel{hn::Sub(p.x, v0.x), hn::Sub(p.y, v0.y), hn::Sub(p.z, v0.z)};
-    const V pError = hn::MulAdd(tError, maxAbs(b.dir),
-                                hn::Mul(hn::Set(d, gamma(3)), hn::Add(hn::Add(maxAbs(b.o), hn::Mul(absT, maxAbs(b.dir))),
-                                                                      hn::Add(v0Max, maxAbs(rel)))));
+    const V pError = hn::MulAdd(
+        tError, maxAbs(b.dir),
+        hn::Mul(hn::Set(d, gamma(3)),
+                hn::Add(hn::Add(maxAbs(b.o), hn::Mul(absT, maxAbs(b.dir))), hn::Add(v0Max, maxAbs(rel)))));
     const V b1 = dot(rel, g1), b2 = dot(rel, g2);
     const V b1Error = hn::MulAdd(g1Sum, pError, hn::Mul(hn::Set(d, gamma(4)), absDot(d, rel, g1)));
     const V b2Error = hn::MulAdd(g2Sum, pError, hn::Mul(hn::Set(d, gamma(4)), absDot(d, rel, g2)));
-    const M outside = hn::Or(hn::Or(hn::Lt(hn::Add(b1, b1Error), zero), hn::Lt(hn::Add(b2, b2Error), zero)),
-                             hn::Gt(hn::Sub(hn::Add(b1, b2), hn::Add(hn::Add(b1Error, b2Error), hn::Set(d, gamma(2)))), one));
+    const M below = hn::Or(hn::Lt(hn::Add(b1, b1Error), zero), hn::Lt(hn::Add(b2, b2Error), zero));
+    const M beyond =
+        tri.parallelogram
+            ? hn::Or(hn::Gt(hn::Sub(b1, b1Error), one), hn::Gt(hn::Sub(b2, b2Error), one))
+            : hn::Gt(hn::Sub(hn::Add(b1, b2), hn::Add(hn::Add(b1Error, b2Error), hn::Set(d, gamma(2)))), one);
+    const M outside = hn::Or(below, beyond);
     const M certainMiss = hn::Or(planeMiss, hn::And(hn::Gt(slack, zero), outside));
     return hn::Not(certainMiss);
   });
@@ -134,20 +142,23 @@ uint32_t SphereCandidates(const RayLanes& rays, const Vec3& center, float radius
     const V dirSum = hn::Add(hn::Add(hn::Abs(b.dir.x), hn::Abs(b.dir.y)), hn::Abs(b.dir.z));
     const V ocSum = hn::Add(hn::Add(hn::Abs(oc.x), hn::Abs(oc.y)), hn::Abs(oc.z));
     const V bb = dot(oc, b.dir);
-    const V bError = hn::MulAdd(hn::Set(d, gamma(4)), absDot(d, oc, b.dir), hn::Mul(hn::Set(d, 1.01f), hn::Mul(e, dirSum)));
+    const V bError = hn::MulAdd(hn::Set(d, gamma(4)), absDot(d, oc, b.dir),
+                                hn::Mul(hn::Set(d, 1.01f), hn::Mul(e, dirSum)));
     const V a = dot(b.dir, b.dir);
     const V aError = hn::Mul(hn::Set(d, gamma(4)), a);
     const V ocLen2 = dot(oc, oc);
     const V cc = hn::Sub(ocLen2, r2);
-    const V cError = hn::MulAdd(hn::Set(d, gamma(5)), hn::Add(ocLen2, r2),
-                                hn::MulAdd(hn::Set(d, 3.03f), hn::Mul(e, e), hn::Mul(hn::Set(d, 2.02f), hn::Mul(e, ocSum))));
+    const V cError = hn::MulAdd(
+        hn::Set(d, gamma(5)), hn::Add(ocLen2, r2),
+        hn::MulAdd(hn::Set(d, 3.03f), hn::Mul(e, e), hn::Mul(hn::Set(d, 2.02f), hn::Mul(e, ocSum))));
     const V disc = hn::Sub(hn::Mul(bb, bb), hn::Mul(a, cc));
     const V absB = hn::Abs(bb), absC = hn::Abs(cc);
-    const V discError = hn::Mul(
-        hn::Set(d, 1.1f),
-        hn::Add(hn::Add(hn::MulAdd(hn::Set(d, 2.0f), hn::Mul(absB, bError), hn::Mul(bError, bError)),
-                        hn::MulAdd(a, cError, hn::Mul(absC, aError))),
-                hn::MulAdd(aError, cError, hn::Mul(hn::Set(d, gamma(3)), hn::MulAdd(absB, absB, hn::Mul(a, absC))))));
+    const V discError =
+        hn::Mul(hn::Set(d, 1.1f),
+                hn::Add(hn::Add(hn::MulAdd(hn::Set(d, 2.0f), hn::Mul(absB, bError), hn::Mul(bError, bError)),
+                                hn::MulAdd(a, cError, hn::Mul(absC, aError))),
+                        hn::MulAdd(aError, cError,
+                                   hn::Mul(hn::Set(d, gamma(3)), hn::MulAdd(absB, absB, hn::Mul(a, absC))))));
     return hn::Not(hn::Lt(hn::Add(disc, discError), hn::Zero(d)));
   });
 }
@@ -161,8 +172,10 @@ namespace ember {
 HWY_EXPORT(TriangleCandidates);
 HWY_EXPORT(SphereCandidates);
 
-TriangleFilter TriangleFilter::of(const Vec3& v0, const Vec3& v1, const Vec3& v2, const DoublePlane& plane) {
+TriangleFilter TriangleFilter::of(const Vec3& v0, const Vec3& v1, const Vec3& v2, const DoublePlane& plane,
+                                  bool parallelogram) {
   TriangleFilter f;
+  f.parallelogram = parallelogram;
   const glm::dvec3 p0(v0), e1 = glm::dvec3(v1) - p0, e2 = glm::dvec3(v2) - p0;
   const glm::dvec3 normal = glm::cross(e1, e2);
   const double len2 = glm::dot(normal, normal);
@@ -170,9 +183,9 @@ TriangleFilter TriangleFilter::of(const Vec3& v0, const Vec3& v1, const Vec3& v2
   f.v0Max = maxComponent(glm::abs(v0));
   f.n = Vec3(plane.n);
   f.d = float(plane.d);
-  // float(d) and float(n) are each within eps of the double values: |d| eps + |n|_1 eps |o|,
-  // the second part scaled by max|o| in the kernel.
-  f.planeError = 2.0f * 0x1p-24f * std::max(std::abs(f.d), 1.0f);
+  // float(d) is within eps |d| of d; the rounding of n adds eps |n|_1 max|o| <= 2 eps max|o|, which
+  // the kernel adds per ray.
+  f.dError = 1.01f * 0x1p-24f * std::abs(f.d);
   if (len2 > 0.0) {
     f.g1 = Vec3(glm::cross(e2, normal) / len2);
     f.g2 = Vec3(glm::cross(normal, e1) / len2);

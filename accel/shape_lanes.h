@@ -34,17 +34,21 @@ struct RayLanes {
 
 // A triangle (v0, v1, v2) as its float filter sees it: the plane dot(n, x) = d, and the dual
 // vectors g1, g2 with b1 = dot(p - v0, g1), b2 = dot(p - v0, g2) for a point p of the plane
-// (the barycentrics of v1 and v2; Moller-Trumbore's u and v).
+// (the barycentrics of v1 and v2; Moller-Trumbore's u and v). With `parallelogram` it stands for
+// the parallelogram v0 + b1 (v1 - v0) + b2 (v2 - v0), 0 <= b1, b2 <= 1: a quad whose two halves
+// it covers exactly, tested once instead of twice.
 struct TriangleFilter {
+  bool parallelogram = false;
   Vec3 v0{0.0f}, n{0.0f, 0.0f, 1.0f}, g1{0.0f}, g2{0.0f};
   float d = 0.0f;
   float v0Max = 0.0f;  // max |v0_i|
   float g1Sum = 0.0f;  // sum |g1_i|
   float g2Sum = 0.0f;
-  float planeError = 0.0f;  // bound on |float d - exact d| plus the rounding of n
+  float dError = 0.0f;  // bound on |float(d) - d|
 
   // `plane` is the one the scalar test uses (the plane through the float vertices).
-  static TriangleFilter of(const Vec3& v0, const Vec3& v1, const Vec3& v2, const DoublePlane& plane);
+  static TriangleFilter of(const Vec3& v0, const Vec3& v1, const Vec3& v2, const DoublePlane& plane,
+                           bool parallelogram = false);
 };
 
 // Bit i set: live lane i may hit the triangle (DoublePlane::crossedWithin and intersectTriangle

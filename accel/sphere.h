@@ -14,7 +14,9 @@ class Sphere final : public Shape {
   std::string_view typeName() const override { return "sphere"; }
   Bounds bounds() const override;
   bool intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const override;
-  uint32_t candidateLanes(const RayLanes& rays) const override { return sphereCandidates(rays, center_, radius_); }
+  uint32_t candidateLanes(const RayLanes& rays) const override {
+    return sphereCandidates(rays, center_, radius_);
+  }
   // Longitude from +z towards +x, latitude from +y (../shared/refs/CONVENTIONS.md).
   Vec2 surfaceUv(const LocalHit& hit) const override;
   SurfacePoint projectToSurface(const Vec3& p, const LocalHit& hit) const override;

@@ -113,8 +113,18 @@ Quad::Quad(const std::array<Vec3, 4>& v, const std::array<Vec2, 4>& uv)
   // A degenerate half (a quad given as a triangle, v3 = v0) has no plane of its own.
   if (!(area1_ > 0.0f)) planes_[1] = planes_[0];
   if (!(area0_ > 0.0f)) planes_[0] = planes_[1];
-  filters_[0] = TriangleFilter::of(v[0], v[1], v[2], planes_[0]);
-  filters_[1] = TriangleFilter::of(v[0], v[2], v[3], planes_[1]);
+  // An exact parallelogram (v2 = v1 + v3 - v0, which double evaluates without rounding) whose
+  // halves lie in planes agreeing far below the filter's float tolerance is filtered in one test.
+  const glm::dvec3 opposite = glm::dvec3(v[1]) + glm::dvec3(v[3]) - glm::dvec3(v[0]);
+  singleFilter_ = opposite == glm::dvec3(v[2]) && area0_ > 0.0f && area1_ > 0.0f &&
+                  glm::length(planes_[0].n - planes_[1].n) < 1e-12 &&
+                  std::abs(planes_[0].d - planes_[1].d) < 1e-12 * (1.0 + std::abs(planes_[0].d));
+  if (singleFilter_) {
+    filters_[0] = filters_[1] = TriangleFilter::of(v[0], v[1], v[3], planes_[0], true);
+  } else {
+    filters_[0] = TriangleFilter::of(v[0], v[1], v[2], planes_[0]);
+    filters_[1] = TriangleFilter::of(v[0], v[2], v[3], planes_[1]);
+  }
 }
 
 Bounds Quad::bounds() const {

@@ -49,7 +49,8 @@ class Quad final : public Shape {
   Bounds bounds() const override;
   bool intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const override;
   uint32_t candidateLanes(const RayLanes& rays) const override {
-    return triangleCandidates(rays, filters_[0]) | triangleCandidates(rays, filters_[1]);
+    const uint32_t first = triangleCandidates(rays, filters_[0]);
+    return singleFilter_ ? first : first | triangleCandidates(rays, filters_[1]);
   }
   // Onto the plane of the half (v0, v1, v2) or (v0, v2, v3) that p lies over: a quad's four
   // vertices need only be coplanar to 1e-4 of its size.
@@ -65,9 +66,10 @@ class Quad final : public Shape {
   std::array<Vec3, 4> v_;
   std::array<Vec2, 4> uv_;
   Vec3 normal_;
-  DoublePlane planes_[2];       // of the halves (v0,v1,v2) and (v0,v2,v3)
-  TriangleFilter filters_[2];  // of the same halves
-  float area0_, area1_;    // of (v0,v1,v2) and (v0,v2,v3)
+  DoublePlane planes_[2];      // of the halves (v0,v1,v2) and (v0,v2,v3)
+  TriangleFilter filters_[2];  // of the same halves, or twice the one of the whole parallelogram
+  bool singleFilter_ = false;
+  float area0_, area1_;  // of (v0,v1,v2) and (v0,v2,v3)
 };
 
 }  // namespace ember

@@ -26,7 +26,8 @@ void shapeBoundsCallback(const RTCBoundsFunctionArguments* args) {
 // into a padded block, so a filter never reads past an array.
 class PacketLanes {
  public:
-  PacketLanes(RTCRayN* rays, unsigned n, const int* valid) : f_(reinterpret_cast<float*>(rays)), n_(n), valid_(valid) {}
+  PacketLanes(RTCRayN* rays, unsigned n, const int* valid)
+      : f_(reinterpret_cast<float*>(rays)), n_(n), valid_(valid) {}
 
   unsigned blocks() const { return (n_ + RayLanes::kMaxLanes - 1) / RayLanes::kMaxLanes; }
   RayLanes block(unsigned k) {
@@ -34,7 +35,12 @@ class PacketLanes {
     const unsigned count = std::min(RayLanes::kMaxLanes, n_ - first);
     if (n_ % RayLanes::kMaxLanes == 0) {
       auto field = [&](unsigned i) { return f_ + i * n_ + first; };
-      return RayLanes{{field(0), field(1), field(2)}, {field(4), field(5), field(6)}, field(3), field(8), valid_ + first, count};
+      return RayLanes{{field(0), field(1), field(2)},
+                      {field(4), field(5), field(6)},
+                      field(3),
+                      field(8),
+                      valid_ + first,
+                      count};
     }
     for (unsigned i = 0; i < RayLanes::kMaxLanes; ++i) {
       const bool in = i < count;
@@ -46,7 +52,12 @@ class PacketLanes {
       pad_.tfar[i] = in ? f_[8 * n_ + first + i] : 0.0f;
       pad_.valid[i] = in ? valid_[first + i] : 0;
     }
-    return RayLanes{{pad_.org[0], pad_.org[1], pad_.org[2]}, {pad_.dir[0], pad_.dir[1], pad_.dir[2]}, pad_.tnear, pad_.tfar, pad_.valid, count};
+    return RayLanes{{pad_.org[0], pad_.org[1], pad_.org[2]},
+                    {pad_.dir[0], pad_.dir[1], pad_.dir[2]},
+                    pad_.tnear,
+                    pad_.tfar,
+                    pad_.valid,
+                    count};
   }
   Ray ray(unsigned i) const {
     Ray r;
@@ -79,7 +90,8 @@ void intersectPacket(const Shape& shape, RTCRayN* rays, unsigned n, const int* v
   PacketLanes packet(rays, n, valid);
   if (n == 1) {
     LocalHit h;
-    if (valid[0] == -1 && shape.intersect(packet.ray(0), packet.tnear(0), packet.ray(0).tMax, h)) report(0u, h);
+    if (valid[0] == -1 && shape.intersect(packet.ray(0), packet.tnear(0), packet.ray(0).tMax, h))
+      report(0u, h);
     return;
   }
   for (unsigned k = 0; k < packet.blocks(); ++k) {

@@ -176,7 +176,8 @@ Runner addBenchCommand(CLI::App& app) {
       ->check(CLI::Range(1, 4096));
   cmd->add_option("--repeat", args->repeat, "Renders per scene; the median is reported (default 3)")
       ->check(CLI::Range(1, 1000));
-  cmd->add_option("--kernel", args->kernel, "wavefront (default), stream or scalar; see `ember render --help`")
+  cmd->add_option("--kernel", args->kernel,
+                  "wavefront (default), stream or scalar; see `ember render --help`")
       ->check(CLI::IsMember({"wavefront", "stream", "scalar"}));
   cmd->add_option("--json", args->json, "Also write the results as JSON (layout: docs/performance.md)");
   return [args] { return runBench(*args); };

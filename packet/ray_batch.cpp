@@ -68,8 +68,8 @@ void ClosestHitBatch::trace(const EmbreeAccel& accel, BatchTraversal traversal) 
   if (traversal == BatchTraversal::Stream) {
     disableLanes(packets_[packets - 1].ray, size_ - (packets - 1) * kLanes);
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
-    rtcIntersectNM(accel.rtcScene(), &context, reinterpret_cast<RTCRayHitN*>(packets_.get()), kLanes,
-                   packets, sizeof(RTCRayHit16));
+    rtcIntersectNM(accel.rtcScene(), &context, reinterpret_cast<RTCRayHitN*>(packets_.get()), kLanes, packets,
+                   sizeof(RTCRayHit16));
     return;
   }
   alignas(64) int valid[kLanes];
@@ -91,7 +91,8 @@ bool ClosestHitBatch::hit(size_t i, RawHit& out) const {
   return true;
 }
 
-ShadowBatch::ShadowBatch(size_t capacity) : capacity_(capacity), packets_(new RTCRay16[packetsFor(capacity)]) {}
+ShadowBatch::ShadowBatch(size_t capacity)
+    : capacity_(capacity), packets_(new RTCRay16[packetsFor(capacity)]) {}
 
 void ShadowBatch::push(const Ray& ray) {
   if (size_ == capacity_) throw std::logic_error("ShadowBatch overflow");

@@ -49,8 +49,8 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
       Wave::Lane& lane = wave.lanes[i];
       lane.x = work.x0 + int(inTile % uint64_t(tileWidth));
       lane.y = work.y0 + int(inTile / uint64_t(tileWidth));
-      lane.sampler = Sampler(work.sampler, work.seed, uint64_t(lane.y) * width + uint64_t(lane.x),
-                             work.firstSample + s);
+      lane.sampler =
+          Sampler(work.sampler, work.seed, uint64_t(lane.y) * width + uint64_t(lane.x), work.firstSample + s);
       if (path_.start(cameraRay(scene, lane.x, lane.y, lane.sampler), lane.path))
         wave.active[active++] = uint16_t(i);
     }
@@ -84,12 +84,14 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
 
       wave.shadows.trace(scene.accel(), traversal_);
       for (size_t j = 0; j < wave.shadows.size(); ++j)
-        if (!wave.shadows.occluded(j)) wave.lanes[wave.shadowOwner[j]].path.radiance += wave.shadowContribution[j];
+        if (!wave.shadows.occluded(j))
+          wave.lanes[wave.shadowOwner[j]].path.radiance += wave.shadowContribution[j];
       std::swap(wave.active, wave.next);
       active = next;
     }
 
-    for (size_t i = 0; i < count; ++i) addToFilm(film, wave.lanes[i].x, wave.lanes[i].y, wave.lanes[i].path.radiance, stats);
+    for (size_t i = 0; i < count; ++i)
+      addToFilm(film, wave.lanes[i].x, wave.lanes[i].y, wave.lanes[i].path.radiance, stats);
   }
 }
 

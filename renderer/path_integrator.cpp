@@ -47,7 +47,8 @@ void PathIntegrator::onMiss(const Scene& scene, PathState& path) const {
   if (const EnvironmentLight* env = scene.environment()) {
     float weight = 1.0f;
     if (!path.previousDelta)
-      weight = emissionWeight(path.previousPdf, scene.lightSampler().pmf(env) * env->pdfDirection(path.ray.dir));
+      weight =
+          emissionWeight(path.previousPdf, scene.lightSampler().pmf(env) * env->pdfDirection(path.ray.dir));
     path.radiance += path.throughput * env->radiance(path.ray.dir) * weight;
   }
 }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "accel/embree_accel.h"
+#include "core/surface_hit.h"
 #include "materials/material.h"
 #include "materials/surface_maps.h"
 #include "renderer/camera.h"
@@ -10,7 +11,6 @@
 #include "renderer/light_sampler.h"
 #include "renderer/sampler.h"
 #include "renderer/strategy.h"
-#include "core/surface_hit.h"
 
 #include <memory>
 #include <optional>

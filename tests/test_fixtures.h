@@ -1,7 +1,7 @@
 // Small helpers several test files share: a flat shading point and a whole-scene render.
 #pragma once
 
-#include "renderer/path_integrator.h"
+#include "packet/wavefront_integrator.h"
 #include "renderer/render.h"
 #include "renderer/scene.h"
 
@@ -17,16 +17,17 @@ inline SurfaceHit flatHit() {
   return hit;
 }
 
-// Renders a built scene at its own image size and depth settings.
+// Renders a built scene at its own image size and depth settings, with the kernel `ember render`
+// uses by default (tests/test_wavefront.cpp holds it equal to the scalar reference).
 inline Film renderFilm(const Scene& scene, int spp, uint64_t seed, RenderStats* stats = nullptr,
                        SamplerType sampler = SamplerType::Independent) {
-  const PathIntegrator integrator(scene.settings);
+  const std::unique_ptr<Integrator> integrator = makeIntegrator(scene.settings, Kernel::Wavefront);
   Film film(scene.settings.width, scene.settings.height);
   RenderOptions options;
   options.spp = spp;
   options.seed = seed;
   options.sampler = sampler;
-  const RenderStats s = render(scene, integrator, options, film);
+  const RenderStats s = render(scene, *integrator, options, film);
   if (stats) *stats = s;
   return film;
 }

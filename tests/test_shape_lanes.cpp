@@ -1,0 +1,244 @@
+// The SIMD lane filters of accel/shape_lanes.h may reject a packet lane only if the shape's scalar
+// intersect() misses it: then packets find exactly the hits single rays find. Checked on the rays
+// where float rounding is most likely to mislead a filter: rays leaving a surface from its offset
+// origin (at grazing angles too), shadow rays that stop just short of the shape, rays aimed at
+// points of the surface and at its edges, for shapes tiny and huge, near the origin and far from
+// it. The filters must also reject most rays that miss, or they would save nothing.
+#include "accel/box.h"
+#include "accel/cylinder.h"
+#include "accel/flipped_shape.h"
+#include "accel/sphere.h"
+#include "accel/triangle.h"
+#include "core/ray_spawn.h"
+#include "core/rng.h"
+#include "core/sampling.h"
+
+#include <gtest/gtest.h>
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace ember {
+namespace {
+
+Vec2 next2(Rng& rng) {
+  const float x = rng.uniform();
+  return {x, rng.uniform()};
+}
+
+Vec3 randomDirection(Rng& rng) {
+  return sampleUniformSphere(next2(rng));
+}
+
+// 16 rays in Embree's structure-of-arrays layout, some lanes dead.
+struct Block {
+  alignas(64) float org[3][RayLanes::kMaxLanes];
+  alignas(64) float dir[3][RayLanes::kMaxLanes];
+  alignas(64) float tnear[RayLanes::kMaxLanes];
+  alignas(64) float tfar[RayLanes::kMaxLanes];
+  alignas(64) int valid[RayLanes::kMaxLanes];
+
+  void set(unsigned i, const Ray& r, bool live) {
+    for (int k = 0; k < 3; ++k) {
+      org[k][i] = r.origin[k];
+      dir[k][i] = r.dir[k];
+    }
+    tnear[i] = 0.0f;
+    tfar[i] = r.tMax;
+    valid[i] = live ? -1 : 0;
+  }
+  RayLanes lanes() const {
+    return RayLanes{{org[0], org[1], org[2]}, {dir[0], dir[1], dir[2]}, tnear, tfar, valid,
+                    RayLanes::kMaxLanes};
+  }
+};
+
+struct Tally {
+  int hits = 0;      // lanes the scalar routine hits
+  int missed = 0;    // ... of them rejected by the filter: must stay 0
+  int misses = 0;    // live lanes the scalar routine misses
+  int rejected = 0;  // ... of them rejected by the filter
+  int deadKept = 0;  // dead lanes reported as candidates: must stay 0
+  std::string example;
+};
+
+using RayMaker = std::function<Ray(Rng&)>;
+
+void check(const Shape& shape, const RayMaker& make, int blocks, uint64_t seed, Tally& t) {
+  Rng rng(seed, 3);
+  for (int b = 0; b < blocks; ++b) {
+    Block block;
+    Ray rays[RayLanes::kMaxLanes];
+    for (unsigned i = 0; i < RayLanes::kMaxLanes; ++i) {
+      rays[i] = make(rng);
+      block.set(i, rays[i], rng.uniform() < 0.85f);
+    }
+    const uint32_t bits = shape.candidateLanes(block.lanes());
+    for (unsigned i = 0; i < RayLanes::kMaxLanes; ++i) {
+      const bool kept = (bits >> i) & 1u;
+      if (block.valid[i] != -1) {
+        t.deadKept += kept;
+        continue;
+      }
+      LocalHit h;
+      if (shape.intersect(rays[i], 0.0f, rays[i].tMax, h)) {
+        ++t.hits;
+        if (!kept && t.missed++ == 0) {
+          char buf[256];
+          std::snprintf(buf, sizeof buf, "o (%.9g %.9g %.9g) d (%.9g %.9g %.9g) tMax %.9g: scalar t %.9g",
+                        rays[i].origin.x, rays[i].origin.y, rays[i].origin.z, rays[i].dir.x, rays[i].dir.y,
+                        rays[i].dir.z, rays[i].tMax, h.t);
+          t.example = buf;
+        }
+      } else {
+        ++t.misses;
+        t.rejected += !kept;
+      }
+    }
+  }
+}
+
+struct ShapeCase {
+  std::string name;
+  std::unique_ptr<Shape> shape;
+  float size;
+  Vec3 center;
+  bool hasFilter;  // shapes without one keep every live lane
+};
+
+std::vector<ShapeCase> cases(const Vec3& at, float s) {
+  std::vector<ShapeCase> out;
+  auto add = [&](std::string name, std::unique_ptr<Shape> shape, bool filter) {
+    out.push_back({std::move(name), std::move(shape), s, at, filter});
+  };
+  add("sphere", std::make_unique<Sphere>(at, s), true);
+  add("flipped sphere", std::make_unique<FlippedShape>(std::make_unique<Sphere>(at, 0.7f * s)), true);
+  const std::array<Vec2, 4> quadUv{Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)};
+  // Axis-aligned rectangle: an exact parallelogram, filtered in one test.
+  add("axis quad",
+      std::make_unique<Quad>(std::array<Vec3, 4>{at + s * Vec3(-1, 0, -1), at + s * Vec3(1, 0, -1),
+                                                 at + s * Vec3(1, 0, 1), at + s * Vec3(-1, 0, 1)},
+                             quadUv),
+      true);
+  // A rotated rectangle (its fourth vertex rounds off the parallelogram), a skewed planar quad
+  // and one whose fourth vertex lifts it 1e-4 out of plane: two filters each.
+  const Vec3 u = glm::normalize(Vec3(0.8f, 0.3f, -0.2f)),
+             w = glm::normalize(glm::cross(u, Vec3(0.1f, 1.0f, 0.3f)));
+  add("rotated quad",
+      std::make_unique<Quad>(
+          std::array<Vec3, 4>{at - s * u - s * w, at + s * u - s * w, at + s * u + s * w, at - s * u + s * w},
+          quadUv),
+      true);
+  add("skewed quad",
+      std::make_unique<Quad>(
+          std::array<Vec3, 4>{at, at + s * u, at + s * (1.6f * u + 0.9f * w), at + s * (0.2f * u + w)},
+          quadUv),
+      true);
+  add("non-planar quad",
+      std::make_unique<Quad>(
+          std::array<Vec3, 4>{at, at + s * u, at + s * (u + w) + 1e-4f * s * glm::cross(u, w), at + s * w},
+          quadUv),
+      true);
+  const std::array<Vec2, 3> triUv{Vec2(0, 0), Vec2(1, 0), Vec2(0, 1)};
+  add("triangle",
+      std::make_unique<Triangle>(
+          std::array<Vec3, 3>{at + s * Vec3(-1, -0.3f, 0.2f), at + s * Vec3(0.9f, 0.1f, -0.4f),
+                              at + s * Vec3(0.1f, 1.1f, 0.3f)},
+          triUv),
+      true);
+  add("sliver triangle",
+      std::make_unique<Triangle>(
+          std::array<Vec3, 3>{at, at + s * Vec3(1, 0, 0), at + s * Vec3(0.5f, 1e-3f, 0)}, triUv),
+      true);
+  add("cylinder (no filter)", std::make_unique<Cylinder>(at - s * u, at + s * u, 0.5f * s, true), false);
+  add("box (no filter)", std::make_unique<Box>(at, Vec3(s), glm::mat3(1.0f)), false);
+  return out;
+}
+
+// Ray families; every one starts from a point related to the shape.
+std::vector<std::pair<std::string, RayMaker>> families(const Shape& shape, float size, const Vec3& center) {
+  std::vector<std::pair<std::string, RayMaker>> out;
+  out.push_back({"random", [=](Rng& rng) {
+                   const Vec3 o = center + 3.0f * size *
+                                               (Vec3(rng.uniform(), rng.uniform(), rng.uniform()) - 0.5f) *
+                                               2.0f;
+                   return Ray{o, randomDirection(rng)};
+                 }});
+  out.push_back({"aimed at the surface", [&shape, size](Rng& rng) {
+                   const ShapeSample s = shape.sampleArea(next2(rng));
+                   const Vec3 o =
+                       s.p + size * std::pow(10.0f, -3.0f + 4.0f * rng.uniform()) * randomDirection(rng);
+                   return Ray{o, glm::normalize(s.p - o)};
+                 }});
+  // Leaving the surface from the offset origin of a sampled point, in any direction: the
+  // reflected, transmitted and grazing rays of a path.
+  out.push_back({"leaving the surface", [&shape](Rng& rng) {
+                   const ShapeSample s = shape.sampleArea(next2(rng));
+                   Vec3 d = randomDirection(rng);
+                   if (rng.uniform() < 0.3f)
+                     d = glm::normalize(d - glm::dot(d, s.n) * s.n * (1.0f - 1e-3f * rng.uniform()));
+                   const float err = roundingErrorBound(maxComponent(glm::abs(s.p)));
+                   return Ray{offsetAlongNormal(s.p, s.n, err, d), d};
+                 }});
+  // Shadow rays to the shape's own surface, which must stop just short of it.
+  out.push_back({"shadow rays to it", [&shape, size](Rng& rng) {
+                   const ShapeSample s = shape.sampleArea(next2(rng));
+                   Vec3 w = randomDirection(rng);
+                   if (glm::dot(w, s.n) < 0.0f) w = -w;
+                   const Vec3 ref = s.p + size * std::pow(10.0f, -3.0f + 3.5f * rng.uniform()) * w;
+                   const float err = roundingErrorBound(maxComponent(glm::abs(ref)) + size);
+                   const Vec3 nFrom = glm::normalize(-w + 0.5f * randomDirection(rng));
+                   return spawnRayTo(ref, nFrom, err, s.p, s.n,
+                                     roundingErrorBound(maxComponent(glm::abs(s.p))));
+                 }});
+  // Just past the rim: points sampled on the surface, pushed outwards in the tangent plane.
+  out.push_back({"at the edges", [&shape, size, center](Rng& rng) {
+                   const ShapeSample s = shape.sampleArea(next2(rng));
+                   const Vec3 out = s.p - center;
+                   const Vec3 tangent = out - glm::dot(out, s.n) * s.n;
+                   const Vec3 target = s.p + (1e-6f * rng.uniform()) * tangent;
+                   const Vec3 o = target + size * (0.1f + rng.uniform()) * randomDirection(rng);
+                   return Ray{o, glm::normalize(target - o), rng.uniform() < 0.5f ? kInfinity : 2.0f * size};
+                 }});
+  return out;
+}
+
+void runAll(const Vec3& at, float size, uint64_t seed) {
+  for (const ShapeCase& c : cases(at, size)) {
+    for (const auto& [family, make] : families(*c.shape, c.size, c.center)) {
+      SCOPED_TRACE(c.name + ", " + family);
+      Tally t;
+      check(*c.shape, make, 400, seed, t);
+      EXPECT_EQ(t.missed, 0) << "the filter rejected " << t.missed << " of " << t.hits
+                             << " lanes the scalar routine hits; first: " << t.example;
+      EXPECT_EQ(t.deadKept, 0);
+      if (family != "random") continue;
+      if (c.hasFilter) {
+        EXPECT_GT(t.rejected, t.misses * 9 / 10) << "rejects too few of " << t.misses << " misses";
+      } else {
+        EXPECT_EQ(t.rejected, 0);
+      }
+    }
+  }
+}
+
+TEST(ShapeLanes, FiltersKeepEveryHitNearTheOrigin) {
+  runAll(Vec3(0.0f), 1.0f, 1);
+}
+
+TEST(ShapeLanes, FiltersKeepEveryHitOfTinyShapes) {
+  runAll(Vec3(0.3f, -0.2f, 0.1f), 1e-3f, 2);
+}
+
+TEST(ShapeLanes, FiltersKeepEveryHitOfHugeShapes) {
+  runAll(Vec3(0.0f, -2e3f, 0.0f), 1e3f, 3);
+}
+
+TEST(ShapeLanes, FiltersKeepEveryHitFarFromTheOrigin) {
+  runAll(Vec3(6e3f, -3.5e3f, 1.1e4f), 2.0f, 4);
+}
+
+}  // namespace
+}  // namespace ember

@@ -1,0 +1,177 @@
+// The wavefront integrator (16-wide Embree packets and ray streams, SIMD lane filters) must
+// produce the scalar reference's image bit for bit, for every shape, material, emitter and light
+// type, every strategy and sampler, any thread count and tile size, and images whose size is not
+// a multiple of the tile or the wave.
+#include "io/scene_loader.h"
+#include "packet/wavefront_integrator.h"
+#include "renderer/render.h"
+
+#include <gtest/gtest.h>
+
+#include "test_paths.h"
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace ember {
+namespace {
+
+struct RenderCase {
+  int threads = 2;
+  int tileSize = 16;
+  int spp = 3;
+  uint64_t firstSample = 0;
+};
+
+Film renderWith(const Scene& scene, Kernel kernel, const RenderCase& c, PathStats* paths = nullptr) {
+  const std::unique_ptr<Integrator> integrator = makeIntegrator(scene.settings, kernel);
+  Film film(scene.settings.width, scene.settings.height);
+  RenderOptions options;
+  options.spp = c.spp;
+  options.seed = scene.settings.seed;
+  options.sampler = scene.settings.sampler;
+  options.threads = c.threads;
+  options.tileSize = c.tileSize;
+  options.firstSample = c.firstSample;
+  const RenderStats stats = render(scene, *integrator, options, film);
+  if (paths) *paths = stats.paths;
+  return film;
+}
+
+// Equal bit for bit, pixel by pixel, in the mean and in the variance.
+void expectIdentical(const Film& a, const Film& b, const std::string& what) {
+  const Image ma = a.mean(), mb = b.mean(), va = a.varianceOfMean(), vb = b.varianceOfMean();
+  ASSERT_EQ(ma.rgb.size(), mb.rgb.size());
+  size_t differing = 0, first = 0;
+  for (size_t i = 0; i < ma.rgb.size(); ++i) {
+    const bool same = std::memcmp(&ma.rgb[i], &mb.rgb[i], sizeof(float)) == 0 &&
+                      std::memcmp(&va.rgb[i], &vb.rgb[i], sizeof(float)) == 0;
+    if (!same && differing++ == 0) first = i / 3;
+  }
+  EXPECT_EQ(differing, 0u) << what << ": " << differing << " channels differ, first in pixel " << first;
+}
+
+Scene loadSmall(const std::string& path, int width, int height) {
+  Scene scene = loadScene(path);
+  scene.settings.width = width;
+  scene.settings.height = height;
+  scene.build();
+  return scene;
+}
+
+void expectKernelsAgree(const Scene& scene, const std::string& name, const RenderCase& c = {}) {
+  const Film reference = renderWith(scene, Kernel::Scalar, c);
+  expectIdentical(reference, renderWith(scene, Kernel::Wavefront, c), name + ": wavefront vs scalar");
+  expectIdentical(reference, renderWith(scene, Kernel::Stream, c), name + ": stream vs scalar");
+}
+
+TEST(Wavefront, SameImageAsScalarOnTheShippedScenes) {
+  for (const char* name : {"cornell-area", "cornell-point", "shapes", "textured", "demo", "gltf-mixed"}) {
+    const Scene scene = loadSmall(test::sourcePath(std::string("scenes/") + name + ".json"), 40, 36);
+    expectKernelsAgree(scene, name);
+  }
+}
+
+TEST(Wavefront, SameImageAsScalarForEveryStrategyAndSampler) {
+  Scene scene = loadSmall(test::sourcePath("scenes/demo.json"), 33, 29);
+  for (Strategy strategy : {Strategy::Mis, Strategy::Bsdf, Strategy::Light})
+    for (SamplerType sampler : {SamplerType::Sobol, SamplerType::Independent}) {
+      scene.settings.strategy = strategy;
+      scene.settings.sampler = sampler;
+      expectKernelsAgree(scene, std::string(strategyName(strategy)) +
+                                    (sampler == SamplerType::Sobol ? " sobol" : " independent"));
+    }
+}
+
+// Emitters of every kind the scene format has, inward-facing and two-sided ones included, with
+// point, spot and directional lights and an environment, and a max depth that cuts paths.
+TEST(Wavefront, SameImageAsScalarForEveryEmitterAndLight) {
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "ember_wavefront_emitters.json").string();
+  std::ofstream(path) << R"({
+    "image": {"width": 31, "height": 27},
+    "camera": {"origin": [0, 1, 4], "target": [0, 0.6, 0], "up": [0, 1, 0], "fov_y_deg": 50},
+    "render": {"max_depth": 6, "rr_depth": 2, "background": [0.05, 0.07, 0.1]},
+    "materials": {
+      "white": {"type": "diffuse", "reflectance": [0.7, 0.7, 0.7]},
+      "gloss": {"type": "phong", "kd": [0.3, 0.3, 0.3], "ks": [0.4, 0.4, 0.4], "exponent": 40},
+      "glass": {"type": "dielectric", "ior_inside": 1.5, "ior_outside": 1.0},
+      "mirror": {"type": "mirror", "reflectance": [0.9, 0.9, 0.9]}
+    },
+    "shapes": [
+      {"type": "quad", "material": "white", "vertices": [[-3, 0, -3], [3, 0, -3], [3, 0, 3], [-3, 0, 3]]},
+      {"type": "sphere", "center": [-1.2, 0.4, 0], "radius": 0.4, "emission": [2, 1, 0.5]},
+      {"type": "sphere", "center": [0, 1.0, -1], "radius": 2.5, "material": "white", "flip_normals": true},
+      {"type": "disc", "center": [0.6, 1.6, 0], "normal": [0, -1, 0], "radius": 0.3, "emission": [3, 3, 3]},
+      {"type": "quad", "vertices": [[-0.4, 1.8, -0.5], [0.4, 1.8, -0.5], [0.4, 1.9, 0.3], [-0.4, 1.9, 0.3]],
+       "emission": [2, 2, 2], "two_sided": true},
+      {"type": "triangle", "vertices": [[1.2, 0.01, 0.5], [1.6, 0.01, 0.5], [1.4, 0.5, 0.4]], "emission": [1, 3, 1]},
+      {"type": "cylinder", "p0": [1.0, 0, -0.8], "p1": [1.0, 0.9, -0.8], "radius": 0.2, "material": "gloss"},
+      {"type": "cone", "base_center": [-0.3, 0, 0.8], "apex": [-0.3, 0.6, 0.8], "radius": 0.25, "emission": [0.5, 0.5, 2]},
+      {"type": "box", "center": [0.2, 0.25, 0.3], "size": [0.5, 0.5, 0.5], "material": "glass"},
+      {"type": "sphere", "center": [-0.5, 0.3, -0.6], "radius": 0.3, "material": "mirror"}
+    ],
+    "lights": [
+      {"type": "point", "position": [0.5, 1.5, 1.0], "intensity": [1, 1, 1]},
+      {"type": "spot", "position": [0, 1.9, 0], "direction": [0, -1, 0], "intensity": 5, "inner_deg": 15, "outer_deg": 30},
+      {"type": "directional", "direction": [0.3, -1, 0.2], "irradiance": [0.5, 0.5, 0.4]}
+    ]
+  })";
+  Scene scene;
+  try {
+    scene = loadScene(path);
+  } catch (const std::exception& e) {
+    FAIL() << e.what();
+  }
+  scene.build();
+  for (Strategy strategy : {Strategy::Mis, Strategy::Bsdf, Strategy::Light}) {
+    scene.settings.strategy = strategy;
+    expectKernelsAgree(scene, std::string("emitters, ") + std::string(strategyName(strategy)));
+  }
+  std::filesystem::remove(path);
+}
+
+// Triangle meshes (Embree's own packet kernels, alpha-tested, normal-mapped) beside shapes.
+TEST(Wavefront, SameImageAsScalarOnGltfMeshes) {
+  for (const char* name : {"scenes/gltf/bricks.gltf", "scenes/gltf/sphere-grid.gltf"}) {
+    const Scene scene = loadSmall(test::sourcePath(name), 37, 21);
+    expectKernelsAgree(scene, name);
+  }
+  const std::string duck = test::sharedGltfDir() + "/Duck/glTF/Duck.gltf";
+  if (std::filesystem::exists(duck)) expectKernelsAgree(loadSmall(duck, 32, 32), "Duck");
+}
+
+// Thread counts, tile sizes that do not divide the image, tiles larger and smaller than a wave,
+// and a sample range that does not start at 0: always the same film.
+TEST(Wavefront, SameImageForAnyThreadsTilesAndSampleRange) {
+  const Scene scene = loadSmall(test::sourcePath("scenes/shapes.json"), 45, 19);
+  const Film reference = renderWith(scene, Kernel::Scalar, RenderCase{1, 16, 5, 7});
+  for (const RenderCase c : {RenderCase{1, 16, 5, 7}, RenderCase{2, 16, 5, 7}, RenderCase{2, 7, 5, 7},
+                             RenderCase{2, 40, 5, 7}, RenderCase{1, 3, 5, 7}}) {
+    expectIdentical(reference, renderWith(scene, Kernel::Wavefront, c),
+                    "threads " + std::to_string(c.threads) + ", tile " + std::to_string(c.tileSize));
+  }
+}
+
+// The ray counters (bench's rays/s) count the same rays in every kernel.
+TEST(Wavefront, CountsTheSameRaysAsScalar) {
+  const Scene scene = loadSmall(test::sourcePath("scenes/cornell-area.json"), 24, 24);
+  PathStats scalar, wave;
+  renderWith(scene, Kernel::Scalar, {}, &scalar);
+  renderWith(scene, Kernel::Wavefront, {}, &wave);
+  EXPECT_EQ(scalar.rays, wave.rays);
+  EXPECT_EQ(scalar.shadowRays, wave.shadowRays);
+  EXPECT_EQ(scalar.vertices, wave.vertices);
+}
+
+TEST(Wavefront, KernelNames) {
+  EXPECT_EQ(parseKernel("wavefront"), Kernel::Wavefront);
+  EXPECT_EQ(parseKernel("stream"), Kernel::Stream);
+  EXPECT_EQ(parseKernel("scalar"), Kernel::Scalar);
+  EXPECT_FALSE(parseKernel("packet").has_value());
+}
+
+}  // namespace
+}  // namespace ember
