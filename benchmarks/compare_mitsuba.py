@@ -8,10 +8,13 @@ Mitsuba interleaved in the same run. Optional dependency, never needed by the te
     DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1 \\
         /tmp/mi/bin/python benchmarks/compare_mitsuba.py --spp 16 64 256 --seeds 3
 
-Prints a Markdown table (the one quoted in docs/performance.md)."""
+Prints a Markdown table (the one quoted in docs/performance.md). Ember's seconds are its render
+loop's, which it prints; Mitsuba's are those of mi.render after a warm-up render has compiled its
+kernels. Both thus leave out process start, scene loading and image output."""
 import argparse
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -29,11 +32,21 @@ def relmse(img, ref):
     return float(np.mean((img - ref) ** 2 / (ref ** 2 + 0.01)))
 
 
-def render_ember(ember, scene, spp, seed, threads, out, sampler):
+def render_ember(ember, scene, spp, seed, threads, out, sampler, kernel):
+    """The image, the render loop's seconds (as Ember reports them: without process start, scene
+    load and EXR write, like Mitsuba's timing of mi.render after its JIT warm-up) and the wall
+    seconds of the whole process."""
     t = time.perf_counter()
-    subprocess.run([ember, "render", scene, "-o", out, "--spp", str(spp), "--seed", str(seed),
-                    "--threads", str(threads), "--sampler", sampler, "-q"], check=True, stderr=subprocess.DEVNULL)
-    return load_exr(out), time.perf_counter() - t
+    run = subprocess.run([ember, "render", scene, "-o", out, "--spp", str(spp), "--seed", str(seed),
+                          "--threads", str(threads), "--sampler", sampler, "--kernel", kernel, "-q"],
+                         check=True, stderr=subprocess.PIPE, text=True)
+    wall = time.perf_counter() - t
+    loop = float(re.search(r"render ([0-9.]+) s", run.stderr).group(1))
+    return load_exr(out), loop, wall
+
+
+def ember_column(kernel, sampler):
+    return f"ember-{sampler}" if kernel == "wavefront" else f"ember-{kernel}-{sampler}"
 
 
 def main():
@@ -43,6 +56,7 @@ def main():
     ap.add_argument("--seeds", type=int, default=3, help="independent renders per cell; relMSE and time are averaged")
     ap.add_argument("--variants", nargs="*", default=["llvm_ad_rgb"])
     ap.add_argument("--samplers", nargs="*", default=["independent", "sobol"], help="Ember samplers to run")
+    ap.add_argument("--kernels", nargs="*", default=["wavefront"], help="Ember kernels to run (--kernel)")
     ap.add_argument("--threads", type=int, default=os.cpu_count())
     ap.add_argument("--ember", default=os.path.join(ROOT, "build", "app", "ember"))
     ap.add_argument("--json", help="also write the raw numbers here")
@@ -58,14 +72,18 @@ def main():
         spec = os.path.join(ROOT, "tests", "data", name, "scene.json")
         for spp in args.spp:
             row = {"scene": name, "spp": spp}
-            for sampler in args.samplers:
-                errs, times = [], []
-                for s in range(args.seeds):
-                    img, dt = render_ember(args.ember, os.path.join(ROOT, "scenes", name + ".json"), spp, 100 + s,
-                                           args.threads, os.path.join(tmp, "e.exr"), sampler)
-                    errs.append(relmse(img, ref))
-                    times.append(dt)
-                row["ember-" + sampler] = {"relmse": float(np.mean(errs)), "seconds": float(np.mean(times))}
+            for kernel in args.kernels:
+                for sampler in args.samplers:
+                    errs, times, walls = [], [], []
+                    for s in range(args.seeds):
+                        img, dt, wall = render_ember(args.ember, os.path.join(ROOT, "scenes", name + ".json"), spp,
+                                                     100 + s, args.threads, os.path.join(tmp, "e.exr"), sampler, kernel)
+                        errs.append(relmse(img, ref))
+                        times.append(dt)
+                        walls.append(wall)
+                    row[ember_column(kernel, sampler)] = {"relmse": float(np.mean(errs)),
+                                                          "seconds": float(np.mean(times)),
+                                                          "wall_seconds": float(np.mean(walls))}
             for variant in args.variants:
                 mi.set_variant(variant)
                 mi.set_log_level(mi.LogLevel.Error)
@@ -83,7 +101,7 @@ def main():
             print(json.dumps(row), file=sys.stderr, flush=True)
 
     pixels = 256 * 256
-    cols = ["ember-" + s for s in args.samplers] + args.variants
+    cols = [ember_column(k, s) for k in args.kernels for s in args.samplers] + args.variants
     base = args.variants[0]
     head = "| scene | spp | " + " | ".join(f"{c} relMSE" for c in cols) + " | " + \
            " | ".join(f"{c} Msamples/s" for c in cols) + " | " + \
