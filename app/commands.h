@@ -15,5 +15,6 @@ Runner addTonemapCommand(CLI::App& app);
 Runner addInfoCommand(CLI::App& app);
 Runner addBenchCommand(CLI::App& app);
 Runner addCompareCommand(CLI::App& app);
+Runner addMergeCommand(CLI::App& app);
 
 }  // namespace ember::cli

@@ -14,7 +14,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   std::map<CLI::App*, ember::cli::Runner> runners;
   for (auto add : {ember::cli::addRenderCommand, ember::cli::addTonemapCommand, ember::cli::addInfoCommand,
-                   ember::cli::addBenchCommand, ember::cli::addCompareCommand}) {
+                   ember::cli::addBenchCommand, ember::cli::addCompareCommand, ember::cli::addMergeCommand}) {
     const size_t before = app.get_subcommands({}).size();
     ember::cli::Runner run = add(app);
     runners[app.get_subcommands({})[before]] = std::move(run);

@@ -1,5 +1,7 @@
 #include "app/commands.h"
 
+#include "app/stop_signals.h"
+#include "checkpoint/checkpoint_file.h"
 #include "io/image_io.h"
 #include "io/input_error.h"
 #include "io/scene_loader.h"
@@ -10,6 +12,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <ctime>
 #include <filesystem>
 #include <memory>
@@ -34,6 +37,9 @@ struct RenderArgs {
   std::string kernel = "wavefront";
   std::string env;
   bool quiet = false;
+  std::string checkpoint, resume, time;
+  double checkpointEvery = 60.0;
+  std::optional<int> passSpp;
 };
 
 void checkOutputPath(const std::string& path, const char* extension, const char* what) {
@@ -75,59 +81,184 @@ void applyEnvironment(const std::string& value, Scene& scene) {
   scene.background = Color(0.0f);
 }
 
-int runRender(const RenderArgs& a) {
-  checkOutputPath(a.output, ".exr", "-o");
-  if (!a.png.empty()) checkOutputPath(a.png, ".png", "--png");
-  if (!a.variance.empty()) checkOutputPath(a.variance, ".exr", "--variance");
+// "90", "90s", "10m", "2h" -> seconds.
+double parseDuration(const std::string& text) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  const std::string unit = end ? std::string(end) : "";
+  const double scale = unit.empty() || unit == "s" ? 1.0 : unit == "m" ? 60.0 : unit == "h" ? 3600.0 : -1.0;
+  if (end == text.c_str() || scale < 0.0 || !std::isfinite(v) || v <= 0.0)
+    throw InputError("--time " + text + ": expected a positive duration such as 90s, 10m or 2h");
+  return v * scale;
+}
 
-  const auto loadStart = std::chrono::steady_clock::now();
+// The scene and settings of this render, from the command line or from a checkpoint.
+struct RenderSetup {
+  Scene scene;
+  RenderIdentity identity;
+  uint64_t firstSample = 0;
+  int passSpp = 4;
+  std::optional<Checkpoint> resumed;
+};
+
+Scene loadConfigured(const std::string& path, int camera, const std::string& env) {
   LoadOptions loadOptions;
-  loadOptions.camera = a.camera;
-  loadOptions.environmentGiven = !a.env.empty();
-  Scene scene = loadScene(a.scene, loadOptions);
-  RenderSettings& s = scene.settings;
+  loadOptions.camera = camera;
+  loadOptions.environmentGiven = !env.empty();
+  Scene scene = loadScene(path, loadOptions);
+  if (!env.empty()) applyEnvironment(env, scene);
+  return scene;
+}
+
+RenderSetup setUp(RenderArgs& a) {
+  RenderSetup setup;
+  if (!a.resume.empty()) {
+    // Everything but the output, the target spp and how the work is run comes from the state.
+    for (const auto& [given, name] :
+         std::vector<std::pair<bool, const char*>>{{!a.scene.empty(), "a scene file"},
+                                                   {a.seed.has_value(), "--seed"},
+                                                   {a.width.has_value(), "--width"},
+                                                   {a.height.has_value(), "--height"},
+                                                   {a.maxDepth.has_value(), "--max-depth"},
+                                                   {!a.sampler.empty(), "--sampler"},
+                                                   {!a.strategy.empty(), "--strategy"},
+                                                   {!a.env.empty(), "--env"},
+                                                   {a.camera >= 0, "--camera"},
+                                                   {a.firstSample != 0, "--first-sample"},
+                                                   {a.passSpp.has_value(), "--pass-spp"}})
+      if (given)
+        throw InputError(std::string("--resume takes the render's settings from its checkpoint; ") + name +
+                         " cannot be given with it");
+    Checkpoint c = readCheckpoint(a.resume);
+    const RenderIdentity& id = c.identity;
+    setup.scene = loadConfigured(id.scene, id.camera, id.env);
+    RenderSettings& s = setup.scene.settings;
+    s.width = id.width;
+    s.height = id.height;
+    s.maxDepth = id.maxDepth;
+    s.rrDepth = id.rrDepth;
+    s.seed = id.seed;
+    s.sampler = id.sampler == "sobol" ? SamplerType::Sobol : SamplerType::Independent;
+    s.strategy = parseStrategy(id.strategy).value_or(Strategy::Mis);
+    s.spp = a.spp.value_or(c.spp);
+    const int held = std::min(c.spp, c.passes * c.passSpp);
+    if (s.spp < held)
+      throw InputError("--spp " + std::to_string(s.spp) + ": the checkpoint already holds " +
+                       std::to_string(held) + " samples per pixel");
+    // Pass p always covers samples [p passSpp, (p + 1) passSpp): a render whose last pass was cut
+    // short by its spp cannot grow without leaving a gap.
+    if (s.spp > held && held % c.passSpp != 0)
+      throw InputError("--spp " + std::to_string(s.spp) + ": the checkpoint's last pass ended at its spp (" +
+                       std::to_string(held) + ", not a multiple of the pass size " +
+                       std::to_string(c.passSpp) + "), so it cannot be extended");
+    setup.identity = identityOf(setup.scene, id.scene, id.camera, id.env);
+    if (const std::string diff = id.differenceFrom(setup.identity); !diff.empty())
+      throw InputError(a.resume + ": the checkpoint no longer matches its scene: " + diff);
+    if (a.output.empty()) a.output = c.output;
+    setup.firstSample = c.firstSample;
+    setup.passSpp = c.passSpp;
+    setup.resumed = std::move(c);
+    return setup;
+  }
+  if (a.scene.empty()) throw InputError("a scene file is required (or --resume FILE)");
+  if (a.output.empty()) throw InputError("-o/--output is required");
+  setup.scene = loadConfigured(a.scene, a.camera, a.env);
+  RenderSettings& s = setup.scene.settings;
   if (a.spp) s.spp = *a.spp;
   if (a.seed) s.seed = *a.seed;
   if (a.width) s.width = *a.width;
   if (a.height) s.height = *a.height;
   if (a.maxDepth) s.maxDepth = *a.maxDepth;
-  if (!a.env.empty()) applyEnvironment(a.env, scene);
   if (a.sampler == "sobol") s.sampler = SamplerType::Sobol;
   if (a.sampler == "independent") s.sampler = SamplerType::Independent;
   if (!a.strategy.empty()) s.strategy = *parseStrategy(a.strategy);  // CLI11 checked the name
+  setup.identity = identityOf(setup.scene, a.scene, a.camera, a.env);
+  setup.firstSample = a.firstSample;
+  setup.passSpp = a.passSpp.value_or(4);
+  return setup;
+}
+
+int runRender(RenderArgs a) {
+  using Clock = std::chrono::steady_clock;
+  StopSignals signals;
+  const auto loadStart = Clock::now();
+  if (!a.output.empty()) checkOutputPath(a.output, ".exr", "-o");
+  if (!a.png.empty()) checkOutputPath(a.png, ".png", "--png");
+  if (!a.variance.empty()) checkOutputPath(a.variance, ".exr", "--variance");
+  if (!a.checkpoint.empty()) checkOutputPath(a.checkpoint, ".ckpt", "--checkpoint");
+  const double budget = a.time.empty() ? 0.0 : parseDuration(a.time);
+
+  RenderSetup setup = setUp(a);
+  checkOutputPath(a.output, ".exr", "-o");
+  Scene& scene = setup.scene;
+  const RenderSettings& s = scene.settings;
   scene.build();
   if (const std::string w = unreachableLightsWarning(scene, s.strategy); !w.empty())
     std::fprintf(stderr, "ember: warning: %s\n", w.c_str());
-  const double loadSeconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - loadStart).count();
+  const double loadSeconds = std::chrono::duration<double>(Clock::now() - loadStart).count();
 
   const std::unique_ptr<Integrator> integrator = makeIntegrator(s, *parseKernel(a.kernel));
-  Film film(s.width, s.height);
+  Film film = setup.resumed ? std::move(setup.resumed->film) : Film(s.width, s.height);
   RenderOptions options;
   options.spp = s.spp;
   options.seed = s.seed;
   options.threads = a.threads.value_or(0);
-  options.firstSample = a.firstSample;
+  options.firstSample = setup.firstSample;
   options.sampler = s.sampler;
   options.progress = !a.quiet;
-  const RenderStats stats = render(scene, *integrator, options, film);
+  options.passSpp = setup.passSpp;
+  options.passesDone = setup.resumed ? setup.resumed->passes : 0;
+  options.stop = &signals.flag();
+  options.timeBudgetSeconds = budget;
 
-  const Image image = film.mean();
-  const Metadata meta{{"ember:scene", a.scene},
-                      {"ember:spp", std::to_string(s.spp)},
+  Checkpoint state;
+  state.identity = setup.identity;
+  state.firstSample = setup.firstSample;
+  state.spp = s.spp;
+  state.passSpp = setup.passSpp;
+  state.output = a.output;
+  state.emberVersion = EMBER_VERSION;
+  const std::string checkpointPath = !a.checkpoint.empty() ? a.checkpoint : a.resume;
+  const bool checkpointing = !a.checkpoint.empty() || (!a.resume.empty() && a.checkpointEvery > 0);
+  auto saveState = [&](const Film& f, int passes) {
+    state.passes = passes;
+    // The film is copied into the state only for the write; the render is paused meanwhile.
+    state.film = f;
+    writeCheckpoint(checkpointPath, state);
+  };
+  auto lastSave = Clock::now();
+  if (checkpointing)
+    options.onPass = [&](const Film& f, int passes) {
+      if (std::chrono::duration<double>(Clock::now() - lastSave).count() < a.checkpointEvery) return;
+      saveState(f, passes);
+      lastSave = Clock::now();
+    };
+  const RenderStats stats = render(scene, *integrator, options, film);
+  if (checkpointing) saveState(film, stats.passes);
+
+  const Metadata meta{{"ember:scene", setup.identity.scene},
+                      {"ember:scene_hash", hexHash(setup.identity.hash())},
+                      {"ember:spp", std::to_string(stats.sppDone)},
+                      {"ember:spp_requested", std::to_string(s.spp)},
+                      {"ember:passes", std::to_string(stats.passes)},
                       {"ember:seed", std::to_string(s.seed)},
                       {"ember:sampler", s.sampler == SamplerType::Sobol ? "sobol" : "independent"},
                       {"ember:strategy", std::string(strategyName(s.strategy))},
-                      {"ember:first_sample", std::to_string(a.firstSample)},
+                      {"ember:max_depth", std::to_string(s.maxDepth)},
+                      {"ember:rr_depth", std::to_string(s.rrDepth)},
+                      {"ember:first_sample", std::to_string(setup.firstSample)},
                       {"ember:render_seconds", std::to_string(stats.seconds)},
                       {"ember:version", EMBER_VERSION},
                       {"DateTime", isoTime()},
                       {"Software", std::string("ember ") + EMBER_VERSION}};
-  writeExr(a.output, image, meta);
-  if (!a.variance.empty()) writeExr(a.variance, film.varianceOfMean(), meta);
-  if (!a.png.empty()) {
-    const ReinhardResult tm = tonemapReinhard(image, ReinhardParams{});
-    writePng(a.png, image.width, image.height, tm.rgb8);
+  if (stats.sppDone > 0) {
+    const Image image = film.mean();
+    writeExr(a.output, image, meta);
+    if (!a.variance.empty()) writeExr(a.variance, film.varianceOfMean(), meta);
+    if (!a.png.empty()) {
+      const ReinhardResult tm = tonemapReinhard(image, ReinhardParams{});
+      writePng(a.png, image.width, image.height, tm.rgb8);
+    }
   }
 
   const double secs = std::max(stats.seconds, 1e-9);
@@ -135,10 +266,19 @@ int runRender(const RenderArgs& a) {
   std::fprintf(stderr,
                "ember: %dx%d, %d spp, %d threads: load+build %.3f s, render %.3f s, %.3f M samples/s, "
                "%.3f M rays/s (%.3f M closest-hit + %.3f M shadow), %llu non-finite samples dropped -> %s\n",
-               s.width, s.height, s.spp, stats.threads, loadSeconds, stats.seconds,
+               s.width, s.height, stats.sppDone, stats.threads, loadSeconds, stats.seconds,
                double(stats.samples) / secs * 1e-6, double(rays) / secs * 1e-6,
                double(stats.paths.rays) / secs * 1e-6, double(stats.paths.shadowRays) / secs * 1e-6,
-               static_cast<unsigned long long>(stats.nonFinite), a.output.c_str());
+               static_cast<unsigned long long>(stats.nonFinite),
+               stats.sppDone > 0 ? a.output.c_str() : "(no pass completed: no image written)");
+  if (stats.outOfTime)
+    std::fprintf(stderr, "ember: --time %s: stopped after %d of %d spp\n", a.time.c_str(), stats.sppDone,
+                 s.spp);
+  if (stats.interrupted) {
+    std::fprintf(stderr, "ember: interrupted after %d of %d spp%s\n", stats.sppDone, s.spp,
+                 checkpointing ? ("; resume with: ember render --resume " + checkpointPath).c_str() : "");
+    return 128 + signals.signal();
+  }
   return 0;
 }
 
@@ -148,10 +288,11 @@ Runner addRenderCommand(CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
   CLI::App* cmd =
       app.add_subcommand("render", "Render a scene (Ember JSON, .gltf or .glb) to a linear float EXR");
-  cmd->add_option("scene", args->scene, "Scene file: Ember JSON (docs/scene-format.md), .gltf or .glb")
-      ->required();
-  cmd->add_option("-o,--output", args->output, "Output EXR (linear float32 RGB), written atomically")
-      ->required();
+  cmd->add_option("scene", args->scene,
+                  "Scene file: Ember JSON (docs/scene-format.md), .gltf or .glb (not with --resume)");
+  cmd->add_option("-o,--output", args->output,
+                  "Output EXR (linear float32 RGB), written atomically (with --resume: default the "
+                  "checkpoint's)");
   cmd->add_option("--png", args->png, "Also write a tone-mapped (Reinhard 2002) sRGB PNG");
   cmd->add_option("--spp", args->spp, "Samples per pixel (default: the scene's render.spp, else 64)")
       ->check(CLI::Range(1, 1 << 24));
@@ -193,6 +334,20 @@ Runner addRenderCommand(CLI::App& app) {
       ->check(CLI::Range(0, 1 << 20));
   cmd->add_option("--variance", args->variance, "Also write the per-pixel variance of the mean as an EXR");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress display (the summary line is still printed)");
+  cmd->add_option("--pass-spp", args->passSpp,
+                  "Samples per pixel per progressive pass (default 4); the image is the same for any value")
+      ->check(CLI::Range(1, 1 << 24));
+  cmd->add_option("--checkpoint", args->checkpoint,
+                  "Save the render's state to this .ckpt file (atomically, every --checkpoint-every seconds, "
+                  "on SIGINT/SIGTERM and at the end) for --resume");
+  cmd->add_option("--checkpoint-every", args->checkpointEvery, "Seconds between checkpoints (default 60)")
+      ->check(CLI::Range(0.0, 1e9));
+  cmd->add_option("--resume", args->resume,
+                  "Continue the render saved in this checkpoint to its spp (or --spp); the image is "
+                  "bit-identical to an uninterrupted render. Keeps checkpointing to the same file");
+  cmd->add_option("--time", args->time,
+                  "Time budget (90s, 10m, 2h): no pass starts that would not end within it; the EXR "
+                  "records the spp reached");
   return [args] { return runRender(*args); };
 }
 

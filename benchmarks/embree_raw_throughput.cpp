@@ -5,9 +5,9 @@
 // on all threads. The scene is Ember's own (analytic user geometry), so the numbers include the
 // cost of our intersection callbacks, exactly as Ember pays it.
 //   embree_raw_throughput [scene.json] [--rays N]
+#include "core/sampling.h"
 #include "io/scene_loader.h"
 #include "packet/ray_batch.h"
-#include "core/sampling.h"
 
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>

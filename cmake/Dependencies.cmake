@@ -8,6 +8,8 @@ find_package(TBB REQUIRED CONFIG)
 find_package(CLI11 REQUIRED CONFIG)
 find_package(nlohmann_json 3.10 REQUIRED CONFIG)
 find_package(Threads REQUIRED)
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(xxhash REQUIRED IMPORTED_TARGET libxxhash)  # content hashes of checkpointed scenes
 find_package(hwy 1.0 REQUIRED CONFIG)  # Highway: SIMD with run-time dispatch (accel/shape_lanes.cpp)
 
 # Quirk 1: OIIO's exported target names /usr/include/opencv4, which is absent without libopencv-dev.

@@ -75,10 +75,22 @@ class GltfImporter {
     throw InputError(path_ + ": " + where + ": " + what);
   }
 
+  static bool recordingRead(std::vector<unsigned char>* out, std::string* err, const std::string& path,
+                            void* files) {
+    const bool ok = tinygltf::ReadWholeFile(out, err, path, nullptr);
+    if (ok) static_cast<std::vector<std::string>*>(files)->push_back(path);
+    return ok;
+  }
+
   void load() {
     namespace fs = std::filesystem;
     if (!fs::exists(path_)) throw InputError(path_ + ": no such file");
     tinygltf::TinyGLTF loader;
+    // tinygltf reads the file and its external buffers and images through these callbacks; the
+    // reads are recorded so that a checkpoint's identity covers them (Scene::sourceFiles).
+    tinygltf::FsCallbacks callbacks{&tinygltf::FileExists, &tinygltf::ExpandFilePath, &recordingRead,
+                                    &tinygltf::WriteWholeFile, &scene_.sourceFiles};
+    loader.SetFsCallbacks(callbacks);
     std::string err, warn;
     std::string ext = fs::path(path_).extension().string();
     for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));

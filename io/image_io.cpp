@@ -109,6 +109,17 @@ Image readImageRgb(const std::string& path) {
   return img;
 }
 
+Metadata readStringMetadata(const std::string& path) {
+  if (!std::filesystem::exists(path)) throw InputError(path + ": no such file");
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) throw InputError(path + ": cannot read image: " + OIIO::geterror());
+  Metadata out;
+  for (const OIIO::ParamValue& p : in->spec().extra_attribs)
+    if (p.type() == OIIO::TypeDesc::STRING) out.emplace_back(p.name().string(), p.get_string());
+  in->close();
+  return out;
+}
+
 void writeExr(const std::string& path, const Image& image, const Metadata& metadata) {
   writeAtomically(path, [&](const std::string& tmp) {
     OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::FLOAT);

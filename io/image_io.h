@@ -31,6 +31,8 @@ Image readImageRgb(const std::string& path);
 
 using Metadata = std::vector<std::pair<std::string, std::string>>;
 void writeExr(const std::string& path, const Image& image, const Metadata& metadata = {});
+// The string attributes of an image file's header (an EXR's ember:* metadata).
+Metadata readStringMetadata(const std::string& path);
 void writePng(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb8);
 
 }  // namespace ember

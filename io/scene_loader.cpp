@@ -126,8 +126,9 @@ class JsonSceneLoader {
     const JsonNode file = n.at("map");
     const TextureFilter filter = readFilter(n);
     try {
-      scene_.environmentMap =
-          loadEnvironmentMap((baseDir_ / file.string()).string(), n.color("scale", Color(1.0f)), filter);
+      const std::string path = (baseDir_ / file.string()).string();
+      scene_.environmentMap = loadEnvironmentMap(path, n.color("scale", Color(1.0f)), filter);
+      scene_.sourceFiles.push_back(path);
     } catch (const InputError& e) {
       file.fail(e.what());
     }
@@ -163,6 +164,7 @@ class JsonSceneLoader {
     TextureImage img;
     try {
       img = ember::readTexture(texPath.string(), encoding);
+      scene_.sourceFiles.push_back(texPath.string());
     } catch (const InputError& e) {
       file.fail(e.what());
     }
@@ -513,6 +515,7 @@ Scene loadJsonScene(const std::string& path) {
   const nlohmann::json doc = JsonNode::parseFile(path);
   Scene scene;
   scene.sourcePath = path;
+  scene.sourceFiles.push_back(path);
   JsonSceneLoader(path, scene).load(JsonNode(doc, "", path));
   return scene;
 }

@@ -1,5 +1,7 @@
 #include "renderer/film.h"
 
+#include <algorithm>
+
 namespace ember {
 
 Film::Film(int width, int height)
@@ -31,6 +33,29 @@ Image Film::varianceOfMean() const {
       img.set(x, y, Color(var / n));
     }
   return img;
+}
+
+void Film::save(int x0, int y0, int x1, int y1, TileBackup& backup) const {
+  const size_t w = size_t(x1 - x0), n = w * size_t(y1 - y0);
+  backup.sum.resize(n);
+  backup.sumSq.resize(n);
+  backup.count.resize(n);
+  for (int y = y0; y < y1; ++y) {
+    const size_t from = size_t(y) * size_t(width_) + size_t(x0), to = size_t(y - y0) * w;
+    std::copy_n(sum_.begin() + from, w, backup.sum.begin() + to);
+    std::copy_n(sumSq_.begin() + from, w, backup.sumSq.begin() + to);
+    std::copy_n(count_.begin() + from, w, backup.count.begin() + to);
+  }
+}
+
+void Film::restore(int x0, int y0, int x1, int y1, const TileBackup& backup) {
+  const size_t w = size_t(x1 - x0);
+  for (int y = y0; y < y1; ++y) {
+    const size_t to = size_t(y) * size_t(width_) + size_t(x0), from = size_t(y - y0) * w;
+    std::copy_n(backup.sum.begin() + from, w, sum_.begin() + to);
+    std::copy_n(backup.sumSq.begin() + from, w, sumSq_.begin() + to);
+    std::copy_n(backup.count.begin() + from, w, count_.begin() + to);
+  }
 }
 
 }  // namespace ember

@@ -49,6 +49,24 @@ class Film {
   // Variance of each pixel's mean: sample variance / n (unbiased, n - 1 in the denominator).
   Image varianceOfMean() const;
 
+  // The accumulation state itself, pixel by pixel (checkpoint files store and restore it exactly).
+  size_t pixelCount() const { return count_.size(); }
+  std::vector<glm::dvec3>& sums() { return sum_; }
+  std::vector<glm::dvec3>& sumsOfSquares() { return sumSq_; }
+  std::vector<uint32_t>& counts() { return count_; }
+  const std::vector<glm::dvec3>& sums() const { return sum_; }
+  const std::vector<glm::dvec3>& sumsOfSquares() const { return sumSq_; }
+  const std::vector<uint32_t>& counts() const { return count_; }
+
+  // The state of the pixels [x0, x1) x [y0, y1), saved before a tile adds a pass so that an
+  // interrupted pass can be taken back exactly (renderer/render.cpp).
+  struct TileBackup {
+    std::vector<glm::dvec3> sum, sumSq;
+    std::vector<uint32_t> count;
+  };
+  void save(int x0, int y0, int x1, int y1, TileBackup& backup) const;
+  void restore(int x0, int y0, int x1, int y1, const TileBackup& backup);
+
  private:
   int width_, height_;
   std::vector<glm::dvec3> sum_, sumSq_;

@@ -11,6 +11,7 @@
 #include <pmmintrin.h>
 #include <xmmintrin.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <mutex>
@@ -19,47 +20,95 @@ namespace ember {
 
 RenderStats render(const Scene& scene, const Integrator& integrator, const RenderOptions& options,
                    Film& film) {
+  using Clock = std::chrono::steady_clock;
   const int width = film.width(), height = film.height();
   const int tile = std::max(1, options.tileSize);
   const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
+  const int tiles = tilesX * tilesY;
   const int threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
+  const int passSpp = std::max(1, options.passSpp);
+  const int passes = passCount(options.spp, passSpp);
+  const uint64_t pixels = uint64_t(width) * uint64_t(height);
+  const auto passSamples = [&](int p) { return std::min(passSpp, options.spp - p * passSpp); };
 
   RenderStats stats;
   stats.threads = threads;
+  stats.passes = std::min(options.passesDone, passes);
+  uint64_t remaining = 0;
+  for (int p = stats.passes; p < passes; ++p) remaining += pixels * uint64_t(passSamples(p));
   std::mutex statsMutex;
-  ProgressReporter progress(uint64_t(width) * uint64_t(height), uint64_t(options.spp), options.progress);
+  ProgressReporter progress(remaining, 1, options.progress);
+  // Backups of each tile's pixels before it adds a pass, to take an interrupted pass back.
+  std::vector<Film::TileBackup> backups(options.stop ? size_t(tiles) : 0);
+  std::vector<uint8_t> rendered(static_cast<size_t>(tiles), 0);
+  const auto stopRequested = [&] { return options.stop && options.stop->load(std::memory_order_relaxed); };
 
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
+  double lastPass = 0.0;
+  const int firstPass = stats.passes;
   tbb::task_arena arena(threads);
-  arena.execute([&] {
-    tbb::parallel_for(
-        tbb::blocked_range<int>(0, tilesX * tilesY, 1),
-        [&](const tbb::blocked_range<int>& range) {
-          // Embree's recommendation: flush denormals to zero in every rendering thread.
-          _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
-          _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
-          PathStats local;
-          for (int t = range.begin(); t != range.end(); ++t) {
-            TileWork work;
-            work.x0 = (t % tilesX) * tile;
-            work.y0 = (t / tilesX) * tile;
-            work.x1 = std::min(work.x0 + tile, width);
-            work.y1 = std::min(work.y0 + tile, height);
-            work.firstSample = options.firstSample;
-            work.spp = options.spp;
-            work.seed = options.seed;
-            work.sampler = options.sampler;
-            integrator.renderTile(scene, work, film, local);
-            progress.advance(uint64_t(work.x1 - work.x0) * uint64_t(work.y1 - work.y0));
-          }
-          std::lock_guard<std::mutex> lock(statsMutex);
-          stats.paths += local;
-        },
-        tbb::simple_partitioner());
-  });
+  for (int p = firstPass; p < passes; ++p) {
+    // The budget admits a pass if the previous one, run again, would end within it; the first
+    // pass of a call always runs, so every render adds at least one.
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    if (p > firstPass && options.timeBudgetSeconds > 0.0 && elapsed + lastPass > options.timeBudgetSeconds) {
+      stats.outOfTime = true;
+      break;
+    }
+    if (stopRequested()) {
+      stats.interrupted = true;
+      break;
+    }
+    const auto passStart = Clock::now();
+    std::fill(rendered.begin(), rendered.end(), 0);
+    arena.execute([&] {
+      tbb::parallel_for(
+          tbb::blocked_range<int>(0, tiles, 1),
+          [&](const tbb::blocked_range<int>& range) {
+            // Embree's recommendation: flush denormals to zero in every rendering thread.
+            _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+            _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+            PathStats local;
+            for (int t = range.begin(); t != range.end(); ++t) {
+              if (stopRequested()) continue;
+              TileWork work;
+              work.x0 = (t % tilesX) * tile;
+              work.y0 = (t / tilesX) * tile;
+              work.x1 = std::min(work.x0 + tile, width);
+              work.y1 = std::min(work.y0 + tile, height);
+              work.firstSample = options.firstSample + uint64_t(p) * uint64_t(passSpp);
+              work.spp = passSamples(p);
+              work.seed = options.seed;
+              work.sampler = options.sampler;
+              if (options.stop) film.save(work.x0, work.y0, work.x1, work.y1, backups[size_t(t)]);
+              integrator.renderTile(scene, work, film, local);
+              rendered[size_t(t)] = 1;
+              progress.advance(uint64_t(work.x1 - work.x0) * uint64_t(work.y1 - work.y0) *
+                               uint64_t(work.spp));
+            }
+            std::lock_guard<std::mutex> lock(statsMutex);
+            stats.paths += local;
+          },
+          tbb::simple_partitioner());
+    });
+    if (std::find(rendered.begin(), rendered.end(), 0) != rendered.end()) {
+      // Interrupted: the film goes back to the passes before this one.
+      for (int t = 0; t < tiles; ++t)
+        if (rendered[size_t(t)]) {
+          const int x0 = (t % tilesX) * tile, y0 = (t / tilesX) * tile;
+          film.restore(x0, y0, std::min(x0 + tile, width), std::min(y0 + tile, height), backups[size_t(t)]);
+        }
+      stats.interrupted = true;
+      break;
+    }
+    lastPass = std::chrono::duration<double>(Clock::now() - passStart).count();
+    stats.samples += pixels * uint64_t(passSamples(p));
+    stats.passes = p + 1;
+    if (options.onPass) options.onPass(film, stats.passes);
+  }
   progress.finish();
-  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  stats.samples = uint64_t(width) * uint64_t(height) * uint64_t(options.spp);
+  stats.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  stats.sppDone = std::min(options.spp, stats.passes * passSpp);
   stats.nonFinite = stats.paths.nonFinite;
   return stats;
 }

@@ -1,13 +1,18 @@
-// Renders a scene into a Film. The image is cut into square tiles; oneTBB's scheduler hands them
-// out from per-thread task deques with work stealing (docs/architecture.md explains the choice).
-// Each pixel belongs to one tile and each (pixel, sample index) has its own random stream, so the
-// result is bit-identical for any thread count.
+// Renders a scene into a Film, in progressive passes: each pass adds `passSpp` samples to every
+// pixel, so at any moment the image is uniformly sampled. A pass cuts the image into square tiles;
+// oneTBB's scheduler hands them out from per-thread task deques with work stealing
+// (docs/architecture.md explains the choice). Each pixel belongs to one tile, each (pixel, sample
+// index) has its own random stream, and a pixel's samples are added in index order whatever the
+// passes, so the result is bit-identical for any thread count and any pass size, and a render
+// resumed from its film after some passes ends bit-identical to one that never stopped.
 #pragma once
 
 #include "renderer/film.h"
 #include "renderer/integrator.h"
 
+#include <atomic>
 #include <cstdint>
+#include <functional>
 
 namespace ember {
 
@@ -19,13 +24,32 @@ struct RenderOptions {
   int tileSize = 16;
   SamplerType sampler = SamplerType::Independent;
   bool progress = false;
+
+  int passSpp = 4;     // samples per pixel per pass (the last pass may take fewer)
+  int passesDone = 0;  // passes the film already holds (a resumed render): pass p renders sample
+                       // indices firstSample + [p passSpp, (p + 1) passSpp)
+  // Set from outside (a signal handler): no new tile starts, and the interrupted pass is taken
+  // back, so the film holds whole passes only. Null: nothing can interrupt.
+  const std::atomic<bool>* stop = nullptr;
+  double timeBudgetSeconds = 0.0;  // > 0: no pass starts that the last one's time says won't fit
+  // Called after each completed pass with the number of passes the film now holds.
+  std::function<void(const Film&, int passes)> onPass;
 };
+
+// How many passes of passSpp make spp.
+inline int passCount(int spp, int passSpp) {
+  return passSpp > 0 ? (spp + passSpp - 1) / passSpp : 0;
+}
 
 struct RenderStats {
   double seconds = 0.0;
   int threads = 0;
-  uint64_t samples = 0;
-  uint64_t nonFinite = 0;  // samples dropped because they were NaN or infinite
+  uint64_t samples = 0;      // samples per pixel added by this call, times the pixel count
+  int passes = 0;            // passes the film holds at the end (earlier ones included)
+  int sppDone = 0;           // samples per pixel the film holds at the end
+  bool interrupted = false;  // options.stop was set
+  bool outOfTime = false;    // the time budget ended the render before options.spp
+  uint64_t nonFinite = 0;    // samples dropped because they were NaN or infinite
   PathStats paths;
 };
 

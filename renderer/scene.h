@@ -49,6 +49,9 @@ class Scene {
 
   // --- filled in by a loader --------------------------------------------------------------
   std::string sourcePath;
+  // Every file the loaders read (the scene file, glTF files and their buffers and images,
+  // textures, environment maps), in reading order: a checkpoint's identity hashes them all.
+  std::vector<std::string> sourceFiles;
   RenderSettings settings;
   CameraParams cameraParams;
   Color background{0.0f};  // constant environment radiance; black = none
