@@ -52,7 +52,7 @@ def main():
         ax.loglog([p[0] for p in pts], [p[1] for p in pts], "o-", label=key)
     ax.set_xlabel("render time (s)")
     ax.set_ylabel("relMSE against the reference")
-    ax.set_title(f"{args.scene}: error against time (16, 64, 256 spp)")
+    ax.set_title(f"{args.scene}: error against time ({', '.join(str(r['spp']) for r in rows)} spp)")
     ax.grid(alpha=0.3, which="both")
     ax.legend()
     fig.tight_layout()
