@@ -2,6 +2,7 @@
 
 #include "app/stop_signals.h"
 #include "checkpoint/checkpoint_file.h"
+#include "distributed/cluster.h"
 #include "io/image_io.h"
 #include "io/input_error.h"
 #include "io/scene_loader.h"
@@ -13,6 +14,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <ctime>
 #include <filesystem>
 #include <memory>
@@ -92,6 +94,13 @@ double parseDuration(const std::string& text) {
   return v * scale;
 }
 
+// Under MPI every rank keeps its own state: out.ckpt becomes out.r0of2.ckpt, out.r1of2.ckpt, ...
+std::string rankFile(const std::string& path, const Cluster& cluster) {
+  if (!cluster.distributed() || path.empty()) return path;
+  const std::string stem = path.substr(0, path.size() - std::string(".ckpt").size());
+  return stem + ".r" + std::to_string(cluster.rank()) + "of" + std::to_string(cluster.size()) + ".ckpt";
+}
+
 // The scene and settings of this render, from the command line or from a checkpoint.
 struct RenderSetup {
   Scene scene;
@@ -129,7 +138,10 @@ RenderSetup setUp(RenderArgs& a) {
       if (given)
         throw InputError(std::string("--resume takes the render's settings from its checkpoint; ") + name +
                          " cannot be given with it");
-    Checkpoint c = readCheckpoint(a.resume);
+    const Cluster& cluster = Cluster::instance();
+    if (cluster.distributed() && a.spp)
+      throw InputError("--spp cannot be changed when resuming under MPI: each rank resumes its own share");
+    Checkpoint c = readCheckpoint(rankFile(a.resume, cluster));
     const RenderIdentity& id = c.identity;
     setup.scene = loadConfigured(id.scene, id.camera, id.env);
     RenderSettings& s = setup.scene.settings;
@@ -180,6 +192,7 @@ RenderSetup setUp(RenderArgs& a) {
 
 int runRender(RenderArgs a) {
   using Clock = std::chrono::steady_clock;
+  const Cluster& cluster = Cluster::instance();
   StopSignals signals;
   const auto loadStart = Clock::now();
   if (!a.output.empty()) checkOutputPath(a.output, ".exr", "-o");
@@ -199,13 +212,25 @@ int runRender(RenderArgs a) {
 
   const std::unique_ptr<Integrator> integrator = makeIntegrator(s, *parseKernel(a.kernel));
   Film film = setup.resumed ? std::move(setup.resumed->film) : Film(s.width, s.height);
+  // This process's samples: all of them, or under MPI its rank's share of every pixel's (a resumed
+  // rank's share is in its own checkpoint).
+  uint64_t first = setup.firstSample;
+  int spp = s.spp;
+  if (cluster.distributed() && !setup.resumed) {
+    const Cluster::Share share = cluster.shareOf(s.spp);
+    first += share.offset;
+    spp = share.count;
+  } else if (setup.resumed) {
+    first = setup.resumed->firstSample;
+    spp = a.spp.value_or(setup.resumed->spp);
+  }
   RenderOptions options;
-  options.spp = s.spp;
+  options.spp = spp;
   options.seed = s.seed;
   options.threads = a.threads.value_or(0);
-  options.firstSample = setup.firstSample;
+  options.firstSample = first;
   options.sampler = s.sampler;
-  options.progress = !a.quiet;
+  options.progress = !a.quiet && cluster.isRoot();
   options.passSpp = setup.passSpp;
   options.passesDone = setup.resumed ? setup.resumed->passes : 0;
   options.stop = &signals.flag();
@@ -213,12 +238,12 @@ int runRender(RenderArgs a) {
 
   Checkpoint state;
   state.identity = setup.identity;
-  state.firstSample = setup.firstSample;
-  state.spp = s.spp;
+  state.firstSample = first;
+  state.spp = spp;
   state.passSpp = setup.passSpp;
   state.output = a.output;
   state.emberVersion = EMBER_VERSION;
-  const std::string checkpointPath = !a.checkpoint.empty() ? a.checkpoint : a.resume;
+  const std::string checkpointPath = rankFile(!a.checkpoint.empty() ? a.checkpoint : a.resume, cluster);
   const bool checkpointing = !a.checkpoint.empty() || (!a.resume.empty() && a.checkpointEvery > 0);
   auto saveState = [&](const Film& f, int passes) {
     state.passes = passes;
@@ -235,10 +260,15 @@ int runRender(RenderArgs a) {
     };
   const RenderStats stats = render(scene, *integrator, options, film);
   if (checkpointing) saveState(film, stats.passes);
+  // Rank 0 gathers the other ranks' sums; only it writes images and reports.
+  const bool interrupted = cluster.any(stats.interrupted);
+  const int sppDone = int(cluster.sum(uint64_t(stats.sppDone)));
+  cluster.reduceToRoot(film);
+  if (!cluster.isRoot()) return interrupted ? 128 + (signals.signal() ? signals.signal() : SIGTERM) : 0;
 
   const Metadata meta{{"ember:scene", setup.identity.scene},
                       {"ember:scene_hash", hexHash(setup.identity.hash())},
-                      {"ember:spp", std::to_string(stats.sppDone)},
+                      {"ember:spp", std::to_string(sppDone)},
                       {"ember:spp_requested", std::to_string(s.spp)},
                       {"ember:passes", std::to_string(stats.passes)},
                       {"ember:seed", std::to_string(s.seed)},
@@ -251,7 +281,7 @@ int runRender(RenderArgs a) {
                       {"ember:version", EMBER_VERSION},
                       {"DateTime", isoTime()},
                       {"Software", std::string("ember ") + EMBER_VERSION}};
-  if (stats.sppDone > 0) {
+  if (sppDone > 0) {
     const Image image = film.mean();
     writeExr(a.output, image, meta);
     if (!a.variance.empty()) writeExr(a.variance, film.varianceOfMean(), meta);
@@ -266,18 +296,21 @@ int runRender(RenderArgs a) {
   std::fprintf(stderr,
                "ember: %dx%d, %d spp, %d threads: load+build %.3f s, render %.3f s, %.3f M samples/s, "
                "%.3f M rays/s (%.3f M closest-hit + %.3f M shadow), %llu non-finite samples dropped -> %s\n",
-               s.width, s.height, stats.sppDone, stats.threads, loadSeconds, stats.seconds,
+               s.width, s.height, sppDone, stats.threads, loadSeconds, stats.seconds,
                double(stats.samples) / secs * 1e-6, double(rays) / secs * 1e-6,
                double(stats.paths.rays) / secs * 1e-6, double(stats.paths.shadowRays) / secs * 1e-6,
                static_cast<unsigned long long>(stats.nonFinite),
-               stats.sppDone > 0 ? a.output.c_str() : "(no pass completed: no image written)");
+               sppDone > 0 ? a.output.c_str() : "(no pass completed: no image written)");
+  if (cluster.distributed())
+    std::fprintf(stderr, "ember: %d MPI ranks, each rendering its share of every pixel's samples\n",
+                 cluster.size());
   if (stats.outOfTime)
-    std::fprintf(stderr, "ember: --time %s: stopped after %d of %d spp\n", a.time.c_str(), stats.sppDone,
-                 s.spp);
-  if (stats.interrupted) {
-    std::fprintf(stderr, "ember: interrupted after %d of %d spp%s\n", stats.sppDone, s.spp,
-                 checkpointing ? ("; resume with: ember render --resume " + checkpointPath).c_str() : "");
-    return 128 + signals.signal();
+    std::fprintf(stderr, "ember: --time %s: stopped after %d of %d spp\n", a.time.c_str(), sppDone, s.spp);
+  if (interrupted) {
+    const std::string resume = !a.checkpoint.empty() ? a.checkpoint : a.resume;
+    std::fprintf(stderr, "ember: interrupted after %d of %d spp%s\n", sppDone, s.spp,
+                 checkpointing ? ("; resume with: ember render --resume " + resume).c_str() : "");
+    return 128 + (signals.signal() ? signals.signal() : SIGTERM);
   }
   return 0;
 }

@@ -9,6 +9,9 @@ find_package(CLI11 REQUIRED CONFIG)
 find_package(nlohmann_json 3.10 REQUIRED CONFIG)
 find_package(Threads REQUIRED)
 find_package(PkgConfig REQUIRED)
+# OpenMPI (libopenmpi-dev) is optional: with it `mpirun -np N ember render` splits a render over
+# N processes (distributed/); without it ember is a job of one process.
+find_package(MPI COMPONENTS CXX QUIET)
 pkg_check_modules(xxhash REQUIRED IMPORTED_TARGET libxxhash)  # content hashes of checkpointed scenes
 find_package(hwy 1.0 REQUIRED CONFIG)  # Highway: SIMD with run-time dispatch (accel/shape_lanes.cpp)
 

@@ -8,6 +8,7 @@ packages=(
   libembree-dev libhwy-dev libxxhash-dev libopenimageio-dev openimageio-tools libopenexr-dev libimath-dev
   libtinygltf-dev libstb-dev libglm-dev libtbb-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libbenchmark-dev libfmt-dev assimp-testmodels
+  libopenmpi-dev openmpi-bin clang-14 libclang-rt-14-dev
 )
 
 missing=()

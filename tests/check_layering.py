@@ -2,14 +2,15 @@
 """Fails when a source folder includes a folder above it in the architecture.
 
 The layers, bottom-up: core <- accel <- materials <- renderer <- packet (batched tracing)
-<- io <- checkpoint <- app. A folder may include its own headers and those of the layers below it, never
+<- io <- checkpoint <- distributed <- app
+(<- fuzz). A folder may include its own headers and those of the layers below it, never
 those above: that keeps the build a DAG and the reading order from scene file to EXR straight.
 """
 import pathlib
 import re
 import sys
 
-ORDER = ["core", "accel", "materials", "renderer", "packet", "io", "checkpoint", "app"]
+ORDER = ["core", "accel", "materials", "renderer", "packet", "io", "checkpoint", "distributed", "app", "fuzz"]
 ALLOWED = {layer: set(ORDER[: i + 1]) for i, layer in enumerate(ORDER)}
 
 root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else ".")

@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (Clang, ASan+UBSan) and runs each one for SECONDS (default 30) from
+# its seed corpus. Used by scripts/test.sh for a short smoke run; fuzz/README.md gives long runs.
+#   fuzz/run.sh [SECONDS]            build in build-fuzz/, corpora in build-fuzz/corpus/<target>/
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds=${1:-30}
+jobs=$(nproc)
+CXX=${CXX:-clang++-14} cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DEMBER_FUZZ=ON \
+  -DEMBER_BUILD_TESTS=OFF >/dev/null
+cmake --build build-fuzz -j "$jobs" --target fuzz_scene_json fuzz_gltf fuzz_checkpoint ember
+
+corpus=build-fuzz/corpus
+mkdir -p "$corpus"/{scene_json,gltf,checkpoint}
+# Seeds: Ember's own scenes; glTF files of every kind, valid and deliberately broken (Debian's
+# assimp-testmodels, the generated showcases, the Khronos samples beside a checkout); a real
+# checkpoint. Copied, so the fuzzer's new inputs never land in the source tree.
+cp scenes/*.json "$corpus/scene_json/"
+find scenes/gltf /usr/share/assimp/models/glTF2 ../shared/assets/gltf \( -name '*.gltf' -o -name '*.glb' \) \
+  -size -2M 2>/dev/null | while read -r f; do cp "$f" "$corpus/gltf/$(echo "$f" | md5sum | cut -c1-16)$(basename "$f" | sed 's/.*\(\.gl[tb]f*\)$/\1/')"; done
+ASAN_OPTIONS=detect_leaks=0 build-fuzz/app/ember render scenes/cornell-area.json -o "$corpus/seed.exr" --width 8 \
+  --height 6 --spp 2 -q --checkpoint "$corpus/checkpoint/seed.ckpt" 2>/dev/null
+rm -f "$corpus/seed.exr"
+
+status=0
+for target in scene_json gltf checkpoint; do
+  echo "fuzz_$target: ${seconds}s from $(ls "$corpus/$target" | wc -l) seeds"
+  if ! ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+      "build-fuzz/fuzz/fuzz_$target" "$corpus/$target" -max_total_time="$seconds" -timeout=20 \
+      -rss_limit_mb=4096 -print_final_stats=1 -artifact_prefix="build-fuzz/crash-$target-" \
+      > "build-fuzz/fuzz_$target.log" 2>&1; then
+    echo "fuzz_$target FOUND A PROBLEM:"; tail -40 "build-fuzz/fuzz_$target.log"; status=1
+  fi
+  grep -E "stat::number_of_executed_units|stat::new_units_added" "build-fuzz/fuzz_$target.log" | sed 's/^/  /'
+done
+exit $status
