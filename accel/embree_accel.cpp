@@ -108,6 +108,7 @@ static RTCRay toRtc(const Ray& ray, float tMin) {
 }
 
 bool EmbreeAccel::intersect(const Ray& ray, RawHit& hit) const {
+  if (!traceable(ray)) return false;
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRayHit rh;
@@ -126,6 +127,7 @@ bool EmbreeAccel::intersect(const Ray& ray, RawHit& hit) const {
 }
 
 bool EmbreeAccel::occluded(const Ray& ray, float tMin) const {
+  if (!traceable(ray)) return false;
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRay r = toRtc(ray, tMin);

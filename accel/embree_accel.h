@@ -8,6 +8,8 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 
 namespace ember {
@@ -19,6 +21,17 @@ struct RawHit {
   Vec3 ng;  // unnormalised for meshes; for shapes, the shape's unit normal
   Vec2 uv;  // shapes: their UV; meshes: barycentrics (b1, b2)
 };
+
+// Whether Embree may be given the ray: every origin and direction coordinate within Embree's
+// FLT_LARGE (1.8e18) and a non-NaN interval, as its RayK::valid() requires (Debian builds Embree
+// with assertions, which abort on anything else). Rays that are not traceable miss everything:
+// they come from degenerate input (a camera at infinity, coordinates near FLT_MAX), and the
+// paths they belong to give non-finite samples, which the film drops.
+inline bool traceable(const Ray& ray) {
+  constexpr float kLarge = 1.844e18f;
+  const float m = std::max(maxComponent(glm::abs(ray.origin)), maxComponent(glm::abs(ray.dir)));
+  return m <= kLarge && !std::isnan(ray.tMax);
+}
 
 class EmbreeAccel {
  public:

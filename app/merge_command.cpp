@@ -21,6 +21,8 @@ namespace {
 struct MergeArgs {
   std::vector<std::string> inputs;
   std::string output;
+  std::vector<std::string> variances;  // --variance: each input's variance-of-the-mean EXR, in order
+  std::string varianceOutput;
 };
 
 // The keys that must agree between inputs: together they say "the same render".
@@ -52,6 +54,11 @@ uint64_t number(const Input& in, const std::string& key) {
 
 int runMerge(const MergeArgs& a) {
   if (a.inputs.size() < 2) throw InputError("merge needs at least two images");
+  if (!a.variances.empty() && a.variances.size() != a.inputs.size())
+    throw InputError("--variance needs one variance EXR per input (" + std::to_string(a.inputs.size()) +
+                     "), got " + std::to_string(a.variances.size()));
+  if (a.variances.empty() != a.varianceOutput.empty())
+    throw InputError("--variance and --variance-output go together");
   std::vector<Input> inputs;
   for (const std::string& path : a.inputs) {
     Input in;
@@ -112,6 +119,30 @@ int runMerge(const MergeArgs& a) {
   }
   meta.emplace_back("ember:sample_ranges", ranges);
   meta.emplace_back("Software", std::string("ember ") + EMBER_VERSION + " merge");
+  if (!a.variances.empty()) {
+    // Each input's mean m and variance of the mean v over n samples give back its sum of squares,
+    // Q = (n - 1) n v + n m^2; the union's variance of the mean is then
+    // (sum Q - N M^2) / ((N - 1) N) with N = sum n and M the merged mean.
+    std::vector<Image> vars;
+    for (size_t k = 0; k < a.variances.size(); ++k) {
+      vars.push_back(readImageRgb(a.variances[k]));
+      if (vars.back().width != base.image.width || vars.back().height != base.image.height)
+        throw InputError(a.variances[k] + ": its size differs from " + inputs[k].path + "'s");
+    }
+    Image var(base.image.width, base.image.height);
+    const double total_ = double(total);
+    for (size_t i = 0; i < var.rgb.size(); ++i) {
+      double q = 0.0;
+      for (size_t k = 0; k < inputs.size(); ++k) {
+        const double n = double(inputs[k].spp), m = inputs[k].image.rgb[i];
+        q += (n - 1.0) * n * double(vars[k].rgb[i]) + n * m * m;
+      }
+      const double mean = out.rgb[i];
+      var.rgb[i] =
+          total > 1 ? float(std::max(0.0, (q - total_ * mean * mean) / ((total_ - 1.0) * total_))) : 0.0f;
+    }
+    writeExr(a.varianceOutput, var, meta);
+  }
   writeExr(a.output, out, meta);
   std::fprintf(stderr, "ember: merged %zu images, %llu spp (samples %s) -> %s\n", inputs.size(),
                static_cast<unsigned long long>(total), ranges.c_str(), a.output.c_str());
@@ -127,6 +158,10 @@ Runner addMergeCommand(CLI::App& app) {
   cmd->add_option("inputs", args->inputs, "EXRs written by `ember render` of the same scene and settings")
       ->required();
   cmd->add_option("-o,--output", args->output, "Output EXR")->required();
+  cmd->add_option("--variance", args->variances,
+                  "Each input's variance EXR (ember render --variance), in the order of the inputs");
+  cmd->add_option("--variance-output", args->varianceOutput,
+                  "Where to write the merged variance of the mean");
   return [args] { return runMerge(*args); };
 }
 

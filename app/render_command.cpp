@@ -142,6 +142,11 @@ RenderSetup setUp(RenderArgs& a) {
     if (cluster.distributed() && a.spp)
       throw InputError("--spp cannot be changed when resuming under MPI: each rank resumes its own share");
     Checkpoint c = readCheckpoint(rankFile(a.resume, cluster));
+    // Another version may draw other samples for the same indices: no longer the same render.
+    if (c.emberVersion != EMBER_VERSION)
+      throw InputError(a.resume + ": written by ember " + c.emberVersion + "; this is ember " +
+                       EMBER_VERSION +
+                       ", whose samples may differ: resume it with the version that wrote it");
     const RenderIdentity& id = c.identity;
     setup.scene = loadConfigured(id.scene, id.camera, id.env);
     RenderSettings& s = setup.scene.settings;

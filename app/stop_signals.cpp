@@ -1,6 +1,6 @@
 #include "app/stop_signals.h"
 
-#include "checkpoint/checkpoint_file.h"
+#include "io/pending_file.h"
 
 #include <unistd.h>
 
@@ -17,7 +17,7 @@ struct sigaction gOldInt, gOldTerm;
 // Only async-signal-safe calls here: atomics, unlink, write, _exit.
 void onSignal(int sig) {
   if (gStop.exchange(true)) {
-    const char* tmp = pendingCheckpointTemp();
+    const char* tmp = pendingFile();
     if (tmp[0] != '\0') ::unlink(tmp);
     static const char msg[] = "\nember: second signal: exiting at once\n";
     [[maybe_unused]] const ssize_t n = ::write(STDERR_FILENO, msg, sizeof msg - 1);

@@ -1,6 +1,7 @@
 #include "checkpoint/checkpoint_file.h"
 
 #include "io/input_error.h"
+#include "io/pending_file.h"
 #include "renderer/render.h"
 
 #include <fcntl.h>
@@ -17,9 +18,6 @@ namespace ember {
 namespace {
 
 constexpr char kMagic[8] = {'E', 'M', 'B', 'E', 'R', 'C', 'K', 'P'};
-// Large enough for any path; written before the temporary file is created, cleared after the
-// rename, read by signal handlers.
-char gPendingTemp[4096] = {0};
 
 template <typename T>
 void put(std::string& out, const T& v) {
@@ -87,10 +85,6 @@ void writeFileDurably(const std::string& path, const std::string& bytes) {
 
 }  // namespace
 
-const char* pendingCheckpointTemp() {
-  return gPendingTemp;
-}
-
 void writeCheckpoint(const std::string& path, const Checkpoint& c) {
   namespace fs = std::filesystem;
   const nlohmann::json header = {{"identity", c.identity.toJson()},
@@ -113,17 +107,17 @@ void writeCheckpoint(const std::string& path, const Checkpoint& c) {
   const fs::path target(path);
   const std::string tmp =
       (target.parent_path() / (target.filename().string() + ".tmp" + std::to_string(::getpid()))).string();
-  if (tmp.size() < sizeof gPendingTemp) std::memcpy(gPendingTemp, tmp.c_str(), tmp.size() + 1);
+  setPendingFile(tmp);
   try {
     writeFileDurably(tmp, bytes);
     fs::rename(tmp, target);
   } catch (...) {
     std::error_code ec;
     fs::remove(tmp, ec);
-    gPendingTemp[0] = '\0';
+    clearPendingFile();
     throw;
   }
-  gPendingTemp[0] = '\0';
+  clearPendingFile();
 }
 
 Checkpoint readCheckpoint(const std::string& path) {

@@ -41,8 +41,4 @@ void writeCheckpoint(const std::string& path, const Checkpoint& checkpoint);
 // uncorrupted Ember checkpoint of this format.
 Checkpoint readCheckpoint(const std::string& path);
 
-// The temporary file a checkpoint is being written to, or "" (for a signal handler to remove
-// before exiting at once). Async-signal-safe to read.
-const char* pendingCheckpointTemp();
-
 }  // namespace ember

@@ -392,7 +392,8 @@ class GltfImporter {
       item.points = std::move(used);
     } else if (mode == kModeLines) {
       for (size_t i = 0; i + 1 < order.size(); i += 2) item.segments.emplace_back(order[i], order[i + 1]);
-    } else {
+    } else {  // kModeLineStrip or kModeLineLoop: consecutive vertices, the loop closed
+      static_assert(kModeLineStrip == kModeLineLoop + 1);
       for (size_t i = 0; i + 1 < order.size(); ++i) item.segments.emplace_back(order[i], order[i + 1]);
       if (mode == kModeLineLoop && order.size() > 2) item.segments.emplace_back(order.back(), order.front());
     }

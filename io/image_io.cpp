@@ -1,6 +1,7 @@
 #include "io/image_io.h"
 
 #include "io/input_error.h"
+#include "io/pending_file.h"
 #include "materials/texture.h"
 
 #include <OpenImageIO/imageio.h>
@@ -48,14 +49,17 @@ void writeAtomically(const std::string& path, WriteFn write) {
   name.append(target.stem().string()).append(".tmp").append(std::to_string(getpid()));
   name.append(target.extension().string());
   const fs::path tmp = target.parent_path() / name;
+  setPendingFile(tmp.string());
   try {
     write(tmp.string());
     fs::rename(tmp, target);
   } catch (...) {
     std::error_code ec;
     fs::remove(tmp, ec);
+    clearPendingFile();
     throw;
   }
+  clearPendingFile();
 }
 
 void writeWithOiio(const std::string& path, const OIIO::ImageSpec& spec, OIIO::TypeDesc type,

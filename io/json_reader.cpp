@@ -13,6 +13,9 @@ nlohmann::json JsonNode::parseFile(const std::string& file) {
   } catch (const nlohmann::json::parse_error& e) {
     // nlohmann's message already carries "at line L, column C".
     throw InputError(file + ": invalid JSON: " + e.what());
+  } catch (const nlohmann::json::exception& e) {
+    // A number too large for a double ("888e888", found by fuzz/fuzz_scene_json) is out_of_range.
+    throw InputError(file + ": invalid JSON: " + e.what());
   }
 }
 

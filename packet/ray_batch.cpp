@@ -13,12 +13,18 @@ size_t packetsFor(size_t capacity) {
   return (capacity + kLanes - 1) / kLanes;
 }
 
+// An untraceable ray (accel/embree_accel.h) becomes an inactive lane at the origin with the
+// empty interval (1, 0): it misses, and as a shadow ray it is unblocked, as EmbreeAccel treats
+// single rays.
 template <typename Packet>
-void writeRay(Packet& p, size_t lane, const Ray& ray) {
+void writeRay(Packet& p, size_t lane, const Ray& given) {
+  static const Ray inactive{Vec3(0.0f), Vec3(0.0f, 0.0f, 1.0f), 0.0f};
+  const bool ok = traceable(given);
+  const Ray& ray = ok ? given : inactive;
   p.org_x[lane] = ray.origin.x;
   p.org_y[lane] = ray.origin.y;
   p.org_z[lane] = ray.origin.z;
-  p.tnear[lane] = 0.0f;
+  p.tnear[lane] = ok ? 0.0f : 1.0f;
   p.dir_x[lane] = ray.dir.x;
   p.dir_y[lane] = ray.dir.y;
   p.dir_z[lane] = ray.dir.z;

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The whole test suite, from a fresh machine: Debian packages, a Release build and every test
-# (unit, glTF, whole-image comparisons), then an ASan+UBSan build running the unit tests.
+# (unit, statistical, whole-image comparisons, MPI with 2 and 3 ranks), then an ASan+UBSan build
+# running the unit tests, then a short run of each libFuzzer target (fuzz/run.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup-deps.sh
@@ -15,4 +16,8 @@ if [ "${EMBER_SKIP_SANITIZERS:-0}" != 1 ]; then
   cmake --build build-sanitize -j "$jobs" --target ember_unit_tests ember
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
     ctest --test-dir build-sanitize --output-on-failure -j "$jobs" -L unit
+fi
+
+if [ "${EMBER_SKIP_FUZZ:-0}" != 1 ]; then
+  fuzz/run.sh "${EMBER_FUZZ_SECONDS:-20}"
 fi

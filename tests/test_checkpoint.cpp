@@ -4,6 +4,7 @@
 #include "checkpoint/checkpoint_file.h"
 #include "io/image_io.h"
 #include "io/input_error.h"
+#include "io/pending_file.h"
 #include "io/scene_loader.h"
 #include "packet/wavefront_integrator.h"
 #include "renderer/render.h"
@@ -161,7 +162,7 @@ TEST(CheckpointFile, RoundTripsExactly) {
   EXPECT_EQ(back.spp, 8);
   EXPECT_EQ(back.output, "out.exr");
   EXPECT_EQ(c.identity.differenceFrom(back.identity), "");
-  EXPECT_EQ(std::strlen(pendingCheckpointTemp()), 0u);
+  EXPECT_EQ(std::strlen(pendingFile()), 0u);
   for (const auto& entry : std::filesystem::directory_iterator(dir.path))
     EXPECT_EQ(entry.path().extension(), ".ckpt") << "temporary file left behind: " << entry.path();
 }
@@ -287,6 +288,30 @@ TEST(CheckpointCli, SigtermWritesTheCompletedPassesAndTheirSpp) {
   EXPECT_LT(std::stoi(spp), 100000);
 }
 
+// A second signal exits at once: whatever was being written is removed, and the last complete
+// checkpoint stays readable.
+TEST(CheckpointCli, ASecondSignalExitsAtOnceAndKeepsTheLastCheckpoint) {
+  test::TempDir dir;
+  const std::string ckpt = dir.file("s.ckpt");
+  for (int delayMs : {0, 5, 20, 60}) {
+    SCOPED_TRACE("second signal after " + std::to_string(delayMs) + " ms");
+    const pid_t pid = spawnEmber("render " + quoted(kScene) + " -o " + quoted(dir.file("out.exr")) +
+                                     " --width 256 --height 256 --spp 100000 --pass-spp 1 -q --checkpoint " +
+                                     quoted(ckpt) + " --checkpoint-every 0",
+                                 dir.file("log"));
+    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+    kill(pid, SIGTERM);
+    std::this_thread::sleep_for(std::chrono::milliseconds(delayMs));
+    kill(pid, SIGTERM);
+    EXPECT_EQ(waitExit(pid), 128 + SIGTERM);
+    ASSERT_TRUE(std::filesystem::exists(ckpt));
+    EXPECT_NO_THROW(readCheckpoint(ckpt));
+    for (const auto& entry : std::filesystem::directory_iterator(dir.path))
+      EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos)
+          << "left behind: " << entry.path();
+  }
+}
+
 TEST(CheckpointCli, TimeBudgetStopsAndRecordsTheSpp) {
   test::TempDir dir;
   const std::string out = dir.file("budget.exr");
@@ -351,6 +376,32 @@ TEST(MergeCli, SampleRangesMergeIntoTheirUnion) {
   for (const auto& [k, v] : readStringMetadata(dir.file("m.exr")))
     if (k == "ember:spp") spp = v;
   EXPECT_EQ(spp, "24");
+
+  // Variance of the mean, merged from each part's mean and variance, against the one render's.
+  ASSERT_EQ(test::runEmber(base + " --spp 24 -o " + quoted(dir.file("all2.exr")) + " --variance " +
+                           quoted(dir.file("all_var.exr")))
+                .exitCode,
+            0);
+  ASSERT_EQ(test::runEmber(base + " --spp 8 -o " + quoted(dir.file("a2.exr")) + " --variance " +
+                           quoted(dir.file("a_var.exr")))
+                .exitCode,
+            0);
+  ASSERT_EQ(test::runEmber(base + " --spp 16 --first-sample 8 -o " + quoted(dir.file("b2.exr")) +
+                           " --variance " + quoted(dir.file("b_var.exr")))
+                .exitCode,
+            0);
+  const test::CliResult mv =
+      test::runEmber("merge " + quoted(dir.file("a2.exr")) + " " + quoted(dir.file("b2.exr")) + " -o " +
+                     quoted(dir.file("m2.exr")) + " --variance " + quoted(dir.file("a_var.exr")) + " " +
+                     quoted(dir.file("b_var.exr")) + " --variance-output " + quoted(dir.file("m_var.exr")));
+  ASSERT_EQ(mv.exitCode, 0) << mv.output;
+  const Image vAll = readImageRgb(dir.file("all_var.exr")), vMerged = readImageRgb(dir.file("m_var.exr"));
+  double worstVar = 0.0, biggest = 0.0;
+  for (float v : vAll.rgb) biggest = std::max(biggest, double(v));
+  for (size_t i = 0; i < vAll.rgb.size(); ++i)
+    worstVar = std::max(worstVar, std::abs(double(vMerged.rgb[i]) - vAll.rgb[i]) /
+                                      std::max(double(vAll.rgb[i]), 1e-4 * biggest));
+  EXPECT_LT(worstVar, 1e-3);
 
   // Overlapping ranges, another seed, another scene, and images not rendered by Ember.
   const test::CliResult overlap =
