@@ -12,7 +12,6 @@ namespace {
 
 std::atomic<bool> gStop{false};
 std::atomic<int> gSignal{0};
-struct sigaction gOldInt, gOldTerm;
 
 // Only async-signal-safe calls here: atomics, unlink, write, _exit.
 void onSignal(int sig) {
@@ -35,14 +34,14 @@ StopSignals::StopSignals() {
   sa.sa_handler = onSignal;
   sigemptyset(&sa.sa_mask);
   sa.sa_flags = SA_RESTART;
-  sigaction(SIGINT, &sa, &gOldInt);
-  sigaction(SIGTERM, &sa, &gOldTerm);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
 }
 
-StopSignals::~StopSignals() {
-  sigaction(SIGINT, &gOldInt, nullptr);
-  sigaction(SIGTERM, &gOldTerm, nullptr);
-}
+// The handlers stay until the process exits: a second signal during the exit that follows the
+// render (writing outputs, tearing down) must still exit at once with 128 + its number, not die
+// of the default action.
+StopSignals::~StopSignals() = default;
 
 const std::atomic<bool>& StopSignals::flag() const {
   return gStop;

@@ -11,7 +11,7 @@ namespace ember::cli {
 class StopSignals {
  public:
   StopSignals();   // installs the handlers
-  ~StopSignals();  // restores the previous ones
+  ~StopSignals();  // leaves them installed until the process exits
   StopSignals(const StopSignals&) = delete;
   StopSignals& operator=(const StopSignals&) = delete;
 

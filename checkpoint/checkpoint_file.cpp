@@ -86,7 +86,6 @@ void writeFileDurably(const std::string& path, const std::string& bytes) {
 }  // namespace
 
 void writeCheckpoint(const std::string& path, const Checkpoint& c) {
-  namespace fs = std::filesystem;
   const nlohmann::json header = {{"identity", c.identity.toJson()},
                                  {"first_sample", c.firstSample},
                                  {"spp", c.spp},
@@ -104,20 +103,7 @@ void writeCheckpoint(const std::string& path, const Checkpoint& c) {
   putArray(bytes, c.film.counts());
   put(bytes, uint64_t(XXH3_64bits(bytes.data(), bytes.size())));
 
-  const fs::path target(path);
-  const std::string tmp =
-      (target.parent_path() / (target.filename().string() + ".tmp" + std::to_string(::getpid()))).string();
-  setPendingFile(tmp);
-  try {
-    writeFileDurably(tmp, bytes);
-    fs::rename(tmp, target);
-  } catch (...) {
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    clearPendingFile();
-    throw;
-  }
-  clearPendingFile();
+  writeAtomically(path, [&](const std::string& tmp) { writeFileDurably(tmp, bytes); });
 }
 
 Checkpoint readCheckpoint(const std::string& path) {

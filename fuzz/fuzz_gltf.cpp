@@ -3,8 +3,6 @@
 // and a 4x4-pixel render. The first input byte picks the file type, so one corpus holds both.
 #include "fuzz/fuzz_input.h"
 #include "io/scene_loader.h"
-#include "packet/wavefront_integrator.h"
-#include "renderer/render.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const std::string gltf = ember::fuzz::inputFile(".gltf"), glb = ember::fuzz::inputFile(".glb");
@@ -14,15 +12,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   ember::fuzz::writeInput(path, data, size);
   ember::fuzz::expectOnlyInputErrors([&] {
     ember::Scene scene = ember::loadScene(path);
-    scene.settings.width = scene.settings.height = 4;
-    scene.settings.maxDepth = 3;
-    scene.build();
-    const auto integrator = ember::makeIntegrator(scene.settings, ember::Kernel::Wavefront);
-    ember::Film film(4, 4);
-    ember::RenderOptions options;
-    options.spp = 1;
-    options.threads = 1;
-    ember::render(scene, *integrator, options, film);
+    ember::fuzz::buildAndRenderTiny(scene, 3);
   });
   return 0;
 }

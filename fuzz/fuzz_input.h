@@ -5,9 +5,12 @@
 #pragma once
 
 #include "io/input_error.h"
+#include "packet/wavefront_integrator.h"
+#include "renderer/render.h"
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -38,6 +41,21 @@ void expectOnlyInputErrors(Body body) {
     std::fprintf(stderr, "fuzz finding: exception other than InputError: %s\n", e.what());
     std::abort();
   }
+}
+
+// Builds a loaded scene and renders one sample of 4x4 pixels with at most `maxDepth` segments:
+// whatever a loader accepts must also build and render without a crash.
+inline void buildAndRenderTiny(Scene& scene, int maxDepth) {
+  scene.settings.width = scene.settings.height = 4;
+  scene.settings.maxDepth =
+      scene.settings.maxDepth < 0 ? maxDepth : std::min(scene.settings.maxDepth, maxDepth);
+  scene.build();
+  const auto integrator = makeIntegrator(scene.settings, Kernel::Wavefront);
+  Film film(4, 4);
+  RenderOptions options;
+  options.spp = 1;
+  options.threads = 1;
+  render(scene, *integrator, options, film);
 }
 
 }  // namespace ember::fuzz

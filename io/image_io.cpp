@@ -39,29 +39,6 @@ Color pixelRgb(const float* p, int channels) {
   return channels >= 3 ? Color(p[0], p[1], p[2]) : Color(p[0]);
 }
 
-// Writes through a temporary name with the same extension (OIIO picks the format by extension),
-// then renames: readers see either no file or the complete one.
-template <typename WriteFn>
-void writeAtomically(const std::string& path, WriteFn write) {
-  namespace fs = std::filesystem;
-  const fs::path target(path);
-  std::string name = ".";  // appended piecewise: GCC 12's -Wrestrict misfires on "." + string
-  name.append(target.stem().string()).append(".tmp").append(std::to_string(getpid()));
-  name.append(target.extension().string());
-  const fs::path tmp = target.parent_path() / name;
-  setPendingFile(tmp.string());
-  try {
-    write(tmp.string());
-    fs::rename(tmp, target);
-  } catch (...) {
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    clearPendingFile();
-    throw;
-  }
-  clearPendingFile();
-}
-
 void writeWithOiio(const std::string& path, const OIIO::ImageSpec& spec, OIIO::TypeDesc type,
                    const void* pixels) {
   auto out = OIIO::ImageOutput::create(path);
