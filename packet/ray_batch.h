@@ -30,6 +30,8 @@ class ClosestHitBatch {
   void trace(const EmbreeAccel& accel, BatchTraversal traversal = BatchTraversal::Packets);
   // The closest hit of ray i, as EmbreeAccel::intersect reports it; false if it hit nothing.
   bool hit(size_t i, RawHit& out) const;
+  // The geomID ray i hit, RTC_INVALID_GEOMETRY_ID for a miss.
+  uint32_t geometryOf(size_t i) const { return packets_[i / 16].hit.geomID[i % 16]; }
 
  private:
   size_t capacity_;

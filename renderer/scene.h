@@ -73,6 +73,8 @@ class Scene {
   bool intersect(const Ray& ray, SurfaceHit& hit) const;
   // The full record of a hit the accelerator found for `ray` (alone or in a batch).
   void surfaceHit(const Ray& ray, const RawHit& raw, SurfaceHit& hit) const;
+  // Geometries in the acceleration structure: every geomID is below this.
+  size_t geometryCount() const { return records_.size(); }
   // True when something blocks the ray before ray.tMax (a shadow ray from core/ray_spawn.h).
   bool occluded(const Ray& ray) const;
 
