@@ -46,6 +46,11 @@ class FlippedShape final : public Shape {
     s.n = -s.n;
     return true;
   }
+  void sampleSolidAngleLanes(SolidAngleLanes& lanes) const override {
+    inner_->sampleSolidAngleLanes(lanes);
+    for (auto& component : lanes.normal)
+      for (float& c : component) c = -c;
+  }
   float pdfSolidAngle(const Vec3& ref, const Vec3& p, const Vec3& n) const override {
     return inner_->pdfSolidAngle(ref, p, -n);
   }

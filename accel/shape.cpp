@@ -50,6 +50,21 @@ bool Shape::sampleSolidAngle(const Vec3& ref, Vec2 u, ShapeSample& s, float& pdf
   return pdf > 0.0f && std::isfinite(pdf);
 }
 
+void Shape::sampleSolidAngleLanes(SolidAngleLanes& lanes) const {
+  for (unsigned i = 0; i < lanes.n; ++i) {
+    ShapeSample s;
+    float pdf = 0.0f;
+    const Vec3 ref(lanes.ref[0][i], lanes.ref[1][i], lanes.ref[2][i]);
+    if (!sampleSolidAngle(ref, Vec2(lanes.u[0][i], lanes.u[1][i]), s, pdf) || !(pdf > 0.0f))
+      s = ShapeSample{Vec3(0.0f), Vec3(0.0f)}, pdf = 0.0f;
+    for (int c = 0; c < 3; ++c) {
+      lanes.p[c][i] = s.p[c];
+      lanes.normal[c][i] = s.n[c];
+    }
+    lanes.pdf[i] = pdf;
+  }
+}
+
 float Shape::pdfSolidAngle(const Vec3& ref, const Vec3& p, const Vec3& n) const {
   return areaToSolidAnglePdf(1.0f / area(), ref, p, n);
 }

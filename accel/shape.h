@@ -4,6 +4,7 @@
 // "front" side, the side an emitting shape emits on.
 #pragma once
 
+#include "accel/sampling_lanes.h"
 #include "accel/shape_lanes.h"
 #include "core/math.h"
 #include "core/ray_spawn.h"
@@ -90,6 +91,9 @@ class Shape {
   // strategy (the sphere's cone of directions) override both functions together.
   virtual bool sampleSolidAngle(const Vec3& ref, Vec2 u, ShapeSample& s, float& pdf) const;
   virtual float pdfSolidAngle(const Vec3& ref, const Vec3& p, const Vec3& n) const;
+  // sampleSolidAngle for the live lanes of `lanes` at once (accel/sampling_lanes.h), a pdf of 0
+  // where it returns false. Shapes with a lane kernel override it; the default goes lane by lane.
+  virtual void sampleSolidAngleLanes(SolidAngleLanes& lanes) const;
 };
 
 // A plane dot(n, x) = d in double precision (n of unit length), precomputed so that projecting a

@@ -99,8 +99,6 @@ static bool useSphericalRectangle(const Vec3& ref, const Vec3& center, float are
   const Vec3 d = ref - center;
   return glm::dot(d, d) < 4.0f * area;
 }
-// Below this solid angle the spherical-rectangle inversion loses float precision.
-constexpr float kMinSphericalRectangle = 1e-4f;
 
 Quad::Quad(const std::array<Vec3, 4>& v, const std::array<Vec2, 4>& uv)
     : rectangle_(isRectangleQuad(v)),
@@ -119,6 +117,8 @@ Quad::Quad(const std::array<Vec3, 4>& v, const std::array<Vec2, 4>& uv)
   singleFilter_ = opposite == glm::dvec3(v[2]) && area0_ > 0.0f && area1_ > 0.0f &&
                   glm::length(planes_[0].n - planes_[1].n) < 1e-12 &&
                   std::abs(planes_[0].d - planes_[1].d) < 1e-12 * (1.0 + std::abs(planes_[0].d));
+  const Vec3 corners[4] = {v[0], v[1], v[2], v[3]};
+  sampling_ = QuadSampling::of(corners, rectangle_, normal_, area0_, area1_);
   if (singleFilter_) {
     filters_[0] = filters_[1] = TriangleFilter::of(v[0], v[1], v[3], planes_[0], true);
   } else {
@@ -155,23 +155,22 @@ SurfacePoint Quad::projectToSurface(const Vec3& p, const LocalHit&) const {
   return planes_[firstHalf ? 0 : 1].project(p);
 }
 
+// One live lane of the lane kernel, so that a single ray and a packet get the same sample.
 bool Quad::sampleSolidAngle(const Vec3& ref, Vec2 u, ShapeSample& s, float& pdf) const {
-  if (rectangle_ && useSphericalRectangle(ref, 0.5f * (v_[0] + v_[2]), area())) {
-    const SphericalRectangle sr(v_[0], v_[1] - v_[0], v_[3] - v_[0], ref);
-    if (sr.solidAngle() > kMinSphericalRectangle) {
-      s.p = sr.sample(u);
-      s.n = normal_;
-      pdf = 1.0f / sr.solidAngle();
-      return true;
-    }
-  }
-  return Shape::sampleSolidAngle(ref, u, s, pdf);
+  SolidAngleLanes lanes;
+  lanes.n = 1;
+  lanes.set(0, ref, u);
+  lanes.padFrom(1);
+  sampleQuadLanes(sampling_, lanes);
+  s = {lanes.point(0), lanes.normalAt(0)};
+  pdf = lanes.pdf[0];
+  return pdf > 0.0f;
 }
 
 float Quad::pdfSolidAngle(const Vec3& ref, const Vec3& p, const Vec3& n) const {
   if (rectangle_ && useSphericalRectangle(ref, 0.5f * (v_[0] + v_[2]), area())) {
     const SphericalRectangle sr(v_[0], v_[1] - v_[0], v_[3] - v_[0], ref);
-    if (sr.solidAngle() > kMinSphericalRectangle) return 1.0f / sr.solidAngle();
+    if (sr.solidAngle() > QuadSampling::kMinSphericalRectangle) return 1.0f / sr.solidAngle();
   }
   return Shape::pdfSolidAngle(ref, p, n);
 }

@@ -59,6 +59,7 @@ class Quad final : public Shape {
   ShapeSample sampleArea(Vec2 u) const override;
   bool sampleSolidAngle(const Vec3& ref, Vec2 u, ShapeSample& s, float& pdf) const override;
   float pdfSolidAngle(const Vec3& ref, const Vec3& p, const Vec3& n) const override;
+  void sampleSolidAngleLanes(SolidAngleLanes& lanes) const override { sampleQuadLanes(sampling_, lanes); }
   bool isRectangle() const { return rectangle_; }
 
  private:
@@ -69,7 +70,8 @@ class Quad final : public Shape {
   DoublePlane planes_[2];      // of the halves (v0,v1,v2) and (v0,v2,v3)
   TriangleFilter filters_[2];  // of the same halves, or twice the one of the whole parallelogram
   bool singleFilter_ = false;
-  float area0_, area1_;  // of (v0,v1,v2) and (v0,v2,v3)
+  float area0_, area1_;    // of (v0,v1,v2) and (v0,v2,v3)
+  QuadSampling sampling_;  // what the light-sampling kernel needs
 };
 
 }  // namespace ember

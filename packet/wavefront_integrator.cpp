@@ -24,6 +24,17 @@ struct Wave {
   std::array<uint16_t, kSize> order;     // batch indices of the bounce, grouped by geometry
   std::array<uint32_t, kSize> groupKey;  // geomID + 1 of each batch index's hit, 0 for a miss
   std::vector<uint16_t> groupStart;      // counting-sort buckets, sized once per scene
+  // The bounce's scattering vertices (index s), in shading order.
+  std::array<uint16_t, kSize> vertexLane;
+  std::array<SurfaceHit, kSize> hits;
+  std::array<LightPick, kSize> picks;
+  std::array<int16_t, kSize> queryOf;  // each vertex's light query, -1 if it samples no light
+  // The light queries (index q), sorted by light: each light samples its run at once.
+  std::array<uint64_t, kSize> queryKey;  // samplerIndex << 16 | vertex
+  std::array<Vec3, kSize> queryRef;
+  std::array<Vec2, kSize> queryU;
+  std::array<LightSample, kSize> querySample;
+  std::array<bool, kSize> querySampled;
   ClosestHitBatch closest{kSize};
   ShadowBatch shadows{kSize};
 };
@@ -48,6 +59,25 @@ void groupByGeometry(Wave& wave, size_t active, size_t geometries) {
   }
   for (size_t b = 1; b <= buckets; ++b) wave.groupStart[b] += wave.groupStart[b - 1];
   for (size_t a = 0; a < active; ++a) wave.order[wave.groupStart[wave.groupKey[a]]++] = uint16_t(a);
+}
+
+// Samples every query's light, one Light::sampleLanes call per run of queries of the same light.
+void sampleLights(Wave& wave, size_t queries) {
+  std::sort(wave.queryKey.begin(), wave.queryKey.begin() + ptrdiff_t(queries));
+  for (size_t q = 0; q < queries; ++q) {
+    const size_t v = wave.queryKey[q] & 0xffffu;
+    wave.queryOf[v] = int16_t(q);
+    wave.queryRef[q] = wave.hits[v].p;
+    wave.queryU[q] = wave.picks[v].u;
+  }
+  for (size_t first = 0; first < queries;) {
+    const Light* light = wave.picks[wave.queryKey[first] & 0xffffu].light;
+    size_t end = first + 1;
+    while (end < queries && (wave.queryKey[end] >> 16) == (wave.queryKey[first] >> 16)) ++end;
+    light->sampleLanes(&wave.queryRef[first], &wave.queryU[first], end - first, &wave.querySample[first],
+                       &wave.querySampled[first]);
+    first = end;
+  }
 }
 
 }  // namespace
@@ -82,9 +112,10 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
       stats.rays += active;
       wave.closest.trace(scene.accel(), traversal_);
 
-      wave.shadows.clear();
+      // The steps of PathIntegrator::onHit, each for the whole bounce: arrival and the light
+      // choice, then the lights' samples, then shadow rays and scattering.
       groupByGeometry(wave, active, scene.geometryCount());
-      size_t next = 0;
+      size_t vertices = 0, queries = 0;
       for (size_t o = 0; o < active; ++o) {
         const size_t a = wave.order[o];
         Wave::Lane& lane = wave.lanes[wave.active[a]];
@@ -93,16 +124,30 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
           path_.onMiss(scene, lane.path);
           continue;
         }
-        SurfaceHit hit;
+        SurfaceHit& hit = wave.hits[vertices];
         scene.surfaceHit(lane.path.ray, raw, hit);
+        if (!path_.arrive(scene, lane.path, hit, stats)) continue;
+        wave.vertexLane[vertices] = wave.active[a];
+        wave.queryOf[vertices] = -1;
+        if (path_.pickLight(scene, hit, lane.sampler, wave.picks[vertices]))
+          wave.queryKey[queries++] = uint64_t(wave.picks[vertices].light->samplerIndex) << 16 | vertices;
+        ++vertices;
+      }
+      sampleLights(wave, queries);
+
+      wave.shadows.clear();
+      size_t next = 0;
+      for (size_t v = 0; v < vertices; ++v) {
+        Wave::Lane& lane = wave.lanes[wave.vertexLane[v]];
+        const int q = wave.queryOf[v];
         ShadowRequest shadow;
-        bool continues;
-        if (path_.onHit(scene, lane.path, hit, lane.sampler, stats, shadow, continues)) {
-          wave.shadowOwner[wave.shadows.size()] = wave.active[a];
+        if (q >= 0 && path_.shadowFor(wave.hits[v], lane.path, wave.picks[v], wave.querySample[size_t(q)],
+                                      wave.querySampled[size_t(q)], stats, shadow)) {
+          wave.shadowOwner[wave.shadows.size()] = wave.vertexLane[v];
           wave.shadowContribution[wave.shadows.size()] = shadow.contribution;
           wave.shadows.push(shadow.ray);
         }
-        if (continues) wave.next[next++] = wave.active[a];
+        if (path_.scatter(lane.path, wave.hits[v], lane.sampler)) wave.next[next++] = wave.vertexLane[v];
       }
 
       wave.shadows.trace(scene.accel(), traversal_);

@@ -1,9 +1,12 @@
 // The path tracer run as a wavefront: a tile's camera samples advance together, one bounce at a
 // time, and each bounce casts all their closest-hit rays, then all their shadow rays, as batches
 // of 16-wide Embree packets (packet/ray_batch.h). Between the casts every path takes exactly the
-// steps PathIntegrator::Li takes (PathIntegrator::onHit, onMiss), with its own sampler, and a
-// pixel's samples reach the film in the order of their indices, so the image equals the scalar
-// reference's bit for bit (tests/test_wavefront.cpp) and is the same for any thread count.
+// steps PathIntegrator::Li takes (PathIntegrator::onHit's steps, onMiss), with its own sampler;
+// each step runs for the whole bounce, its hits grouped by geometry, and the lights sample their
+// vertices together (Light::sampleLanes, a SIMD kernel for quads). A lane's result never depends
+// on its neighbours, and a pixel's samples reach the film in the order of their indices, so the
+// image equals the scalar reference's bit for bit (tests/test_wavefront.cpp) and is the same for
+// any thread count.
 #pragma once
 
 #include "packet/ray_batch.h"

@@ -56,10 +56,33 @@ static float errorBoundWithin(const Bounds& b) {
 AreaLight::AreaLight(const Shape* shape, const Color& radiance, bool twoSided)
     : shape_(shape), radiance_(radiance), twoSided_(twoSided), pError_(errorBoundWithin(shape->bounds())) {}
 
+void Light::sampleLanes(const Vec3* refs, const Vec2* us, size_t n, LightSample* out, bool* ok) const {
+  for (size_t i = 0; i < n; ++i) ok[i] = sample(refs[i], us[i], out[i]);
+}
+
 bool AreaLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
   ShapeSample s;
   float pdf;
-  if (!shape_->sampleSolidAngle(ref, u, s, pdf)) return false;
+  // pdf > 0 decides, as in sampleLanes, whatever the shape returned.
+  return shape_->sampleSolidAngle(ref, u, s, pdf) && pdf > 0.0f && fromShapeSample(ref, s, pdf, out);
+}
+
+void AreaLight::sampleLanes(const Vec3* refs, const Vec2* us, size_t n, LightSample* out, bool* ok) const {
+  SolidAngleLanes lanes;
+  for (size_t first = 0; first < n; first += SolidAngleLanes::kMaxLanes) {
+    lanes.n = unsigned(std::min<size_t>(SolidAngleLanes::kMaxLanes, n - first));
+    for (unsigned i = 0; i < lanes.n; ++i) lanes.set(i, refs[first + i], us[first + i]);
+    lanes.padFrom(lanes.n);
+    shape_->sampleSolidAngleLanes(lanes);
+    for (unsigned i = 0; i < lanes.n; ++i) {
+      const float pdf = lanes.pdf[i];
+      ok[first + i] = pdf > 0.0f && fromShapeSample(refs[first + i], {lanes.point(i), lanes.normalAt(i)}, pdf,
+                                                    out[first + i]);
+    }
+  }
+}
+
+bool AreaLight::fromShapeSample(const Vec3& ref, const ShapeSample& s, float pdf, LightSample& out) const {
   const Vec3 d = s.p - ref;
   out.dist = glm::length(d);
   if (out.dist == 0.0f) return false;

@@ -9,8 +9,8 @@
 
 #include "accel/shape.h"
 #include "accel/triangle_mesh.h"
-#include "materials/texture.h"
 #include "core/distribution.h"
+#include "materials/texture.h"
 
 #include <memory>
 
@@ -36,6 +36,10 @@ class Light {
   // Total emitted power, used to choose among lights; sceneRadius bounds infinite lights.
   virtual Color power(float sceneRadius) const = 0;
   virtual bool isDelta() const { return false; }
+  // sample() for n reference points at once: sample(refs[i], us[i], out[i]) into ok[i], bit for
+  // bit. The default goes point by point; lights with a lane kernel (accel/sampling_lanes.h)
+  // override it.
+  virtual void sampleLanes(const Vec3* refs, const Vec2* us, size_t n, LightSample* out, bool* ok) const;
 
   int samplerIndex = -1;  // position in the LightSampler's table
 };
@@ -104,10 +108,15 @@ class AreaLight final : public Light {
   float pdf(const Vec3& ref, const Vec3& p, const Vec3& n) const override {
     return shape_->pdfSolidAngle(ref, p, n);
   }
+  // Blocks of the shape's sampleSolidAngleLanes.
+  void sampleLanes(const Vec3* refs, const Vec2* us, size_t n, LightSample* out, bool* ok) const override;
   // Lambertian emitter: Phi = pi * A * L per emitting side.
   Color power(float) const override { return (twoSided_ ? 2.0f : 1.0f) * kPi * shape_->area() * radiance_; }
 
  private:
+  // The light sample from the shape's sample (s, pdf) seen from ref.
+  bool fromShapeSample(const Vec3& ref, const ShapeSample& s, float pdf, LightSample& out) const;
+
   const Shape* shape_;
   Color radiance_;
   bool twoSided_;

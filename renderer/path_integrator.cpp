@@ -4,23 +4,31 @@
 
 namespace ember {
 
-bool PathIntegrator::sampleLight(const Scene& scene, const SurfaceHit& hit, const Vec3& wo, Sampler& sampler,
-                                 ShadowRequest& shadow) const {
-  float pick;
-  const Light* light = scene.lightSampler().sample(sampler.get1D(), pick);
-  const Vec2 u = sampler.get2D();
-  LightSample ls;
-  if (!light || !light->sample(hit.p, u, ls) || ls.pdf <= 0.0f || isBlack(ls.Li)) return false;
+bool PathIntegrator::pickLight(const Scene& scene, const SurfaceHit& hit, Sampler& sampler,
+                               LightPick& pick) const {
+  const LightSampler& lights = scene.lightSampler();
+  if (strategy_ == Strategy::Bsdf || !hit.material->hasNonDeltaLobes() || lights.empty()) return false;
+  pick.light = lights.sample(sampler.get1D(), pick.pmf);
+  pick.u = sampler.get2D();
+  return pick.light != nullptr;
+}
+
+bool PathIntegrator::shadowFor(const SurfaceHit& hit, const PathState& path, const LightPick& pick,
+                               const LightSample& ls, bool sampled, PathStats& stats,
+                               ShadowRequest& shadow) const {
+  if (!sampled || ls.pdf <= 0.0f || isBlack(ls.Li)) return false;
   float bsdfPdf = 0.0f;
+  const Vec3 wo = -path.ray.dir;
   const Color f = hit.material->evalPdf(hit, wo, ls.wi, bsdfPdf);
   if (isBlack(f)) return false;
 
   // Lights at a finite distance: a segment between the two points that neither surface blocks.
   shadow.ray = std::isfinite(ls.dist) ? spawnRayTo(hit.p, hit.ng, hit.pError, ls.p, ls.n, ls.pError)
                                       : Ray{hit.offsetOrigin(ls.wi), ls.wi, kInfinity};
-  const float lightPdf = pick * ls.pdf;
+  const float lightPdf = pick.pmf * ls.pdf;
   const float weight = ls.delta || strategy_ == Strategy::Light ? 1.0f : powerHeuristic(lightPdf, bsdfPdf);
-  shadow.contribution = f * ls.Li * (weight / lightPdf);
+  shadow.contribution = path.throughput * (f * ls.Li * (weight / lightPdf));
+  ++stats.shadowRays;
   return true;
 }
 
@@ -56,6 +64,20 @@ void PathIntegrator::onMiss(const Scene& scene, PathState& path) const {
 bool PathIntegrator::onHit(const Scene& scene, PathState& path, const SurfaceHit& hit, Sampler& sampler,
                            PathStats& stats, ShadowRequest& shadow, bool& continues) const {
   continues = false;
+  if (!arrive(scene, path, hit, stats)) return false;
+  LightPick pick;
+  bool hasShadow = false;
+  if (pickLight(scene, hit, sampler, pick)) {
+    LightSample ls;
+    const bool sampled = pick.light->sample(hit.p, pick.u, ls);
+    hasShadow = shadowFor(hit, path, pick, ls, sampled, stats, shadow);
+  }
+  continues = scatter(path, hit, sampler);
+  return hasShadow;
+}
+
+bool PathIntegrator::arrive(const Scene& scene, PathState& path, const SurfaceHit& hit,
+                            PathStats& stats) const {
   ++stats.vertices;
   const Ray& ray = path.ray;
   const Vec3 wo = -ray.dir;
@@ -76,21 +98,15 @@ bool PathIntegrator::onHit(const Scene& scene, PathState& path, const SurfaceHit
     path.radiance += path.throughput * emitted * weight;
   }
 
-  if ((maxDepth_ >= 0 && path.depth >= maxDepth_) || !hit.material) return false;
+  return !(maxDepth_ >= 0 && path.depth >= maxDepth_) && hit.material;
+}
 
-  bool hasShadow = false;
-  if (strategy_ != Strategy::Bsdf && hit.material->hasNonDeltaLobes() && !lights.empty() &&
-      sampleLight(scene, hit, wo, sampler, shadow)) {
-    shadow.contribution = path.throughput * shadow.contribution;
-    ++stats.shadowRays;
-    hasShadow = true;
-  }
-
+bool PathIntegrator::scatter(PathState& path, const SurfaceHit& hit, Sampler& sampler) const {
   BsdfSample bs;
   const Vec2 u = sampler.get2D();
-  if (!hit.material->sample(hit, wo, u, sampler.get1D(), bs)) return hasShadow;
+  if (!hit.material->sample(hit, -path.ray.dir, u, sampler.get1D(), bs)) return false;
   path.throughput *= bs.weight;
-  if (isBlack(path.throughput)) return hasShadow;
+  if (isBlack(path.throughput)) return false;
   path.previousDelta = bs.delta;
   path.previousPdf = bs.pdf;
   path.previousPoint = hit.p;
@@ -99,12 +115,11 @@ bool PathIntegrator::onHit(const Scene& scene, PathState& path, const SurfaceHit
 
   if (path.depth >= rrDepth_) {
     const float q = std::min(maxComponent(path.throughput) * path.etaProduct * path.etaProduct, 0.95f);
-    if (sampler.get1D() >= q) return hasShadow;
+    if (sampler.get1D() >= q) return false;
     path.throughput /= q;
   }
   ++path.depth;
-  continues = true;
-  return hasShadow;
+  return true;
 }
 
 Color PathIntegrator::Li(const Scene& scene, Ray ray, Sampler& sampler, PathStats& stats) const {

@@ -49,6 +49,13 @@ struct ShadowRequest {
   Color contribution;
 };
 
+// The light next-event estimation chose at a vertex, with the random numbers for its sample.
+struct LightPick {
+  const Light* light = nullptr;
+  float pmf = 0.0f;
+  Vec2 u{0.0f};
+};
+
 class PathIntegrator final : public Integrator {
  public:
   PathIntegrator(int maxDepth, int rrDepth, Strategy strategy = Strategy::Mis)
@@ -71,9 +78,19 @@ class PathIntegrator final : public Integrator {
   bool onHit(const Scene& scene, PathState& path, const SurfaceHit& hit, Sampler& sampler, PathStats& stats,
              ShadowRequest& shadow, bool& continues) const;
 
+  // onHit in its steps, for loops that sample the lights of many vertices together
+  // (Light::sampleLanes): arrive, then pickLight, the light's sample, shadowFor, and scatter.
+  // Emission and absorption on arrival; false if the path ends here without scattering.
+  bool arrive(const Scene& scene, PathState& path, const SurfaceHit& hit, PathStats& stats) const;
+  // Chooses the light to sample and draws its random numbers; false if the vertex samples none.
+  bool pickLight(const Scene& scene, const SurfaceHit& hit, Sampler& sampler, LightPick& pick) const;
+  // The shadow ray for the light's sample `ls` (valid when `sampled`); false if there is none.
+  bool shadowFor(const SurfaceHit& hit, const PathState& path, const LightPick& pick, const LightSample& ls,
+                 bool sampled, PathStats& stats, ShadowRequest& shadow) const;
+  // Samples the path's next ray and applies Russian roulette; false if the path ends.
+  bool scatter(PathState& path, const SurfaceHit& hit, Sampler& sampler) const;
+
  private:
-  bool sampleLight(const Scene& scene, const SurfaceHit& hit, const Vec3& wo, Sampler& sampler,
-                   ShadowRequest& shadow) const;
   // Weight of emission that a BSDF-sampled direction (density bsdfPdf) found, where light sampling
   // would have produced it with density lightPdf.
   float emissionWeight(float bsdfPdf, float lightPdf) const;

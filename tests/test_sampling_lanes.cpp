@@ -1,0 +1,262 @@
+// Light sampling over lanes (accel/sampling_lanes.h, Light::sampleLanes) must give each lane
+// exactly what a single call gives, whatever its neighbours: the wavefront samples the lights of a
+// whole bounce together and the scalar reference one vertex at a time, and their images must stay
+// equal bit for bit. The quad's kernel (SIMD inverse trigonometry) must also agree with the scalar
+// spherical-rectangle and area-sampling formulas it replaces, to float precision; its
+// distribution is checked by the chi-square tests of tests/test_chi2.cpp.
+#include "accel/flipped_shape.h"
+#include "accel/sphere.h"
+#include "accel/spherical_rectangle.h"
+#include "accel/triangle.h"
+#include "core/rng.h"
+#include "core/sampling.h"
+#include "renderer/light.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace ember {
+namespace {
+
+Vec2 next2(Rng& rng) {
+  const float x = rng.uniform();
+  return {x, rng.uniform()};
+}
+
+struct QuadCase {
+  std::string name;
+  std::array<Vec3, 4> v;
+};
+
+// Rectangles and general quads, tiny, huge, far from the origin and turned.
+std::vector<QuadCase> quadCases() {
+  const std::array<Vec2, 4> unit = {Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)};
+  auto placed = [&](const Vec3& origin, const Vec3& ex, const Vec3& ey) {
+    std::array<Vec3, 4> v;
+    for (int i = 0; i < 4; ++i) v[size_t(i)] = origin + unit[size_t(i)].x * ex + unit[size_t(i)].y * ey;
+    return v;
+  };
+  const Vec3 tx = glm::normalize(Vec3(1.0f, 0.3f, -0.2f));
+  const Vec3 ty = glm::normalize(glm::cross(Vec3(0.1f, 0.2f, 1.0f), tx));
+  std::vector<QuadCase> cases = {
+      {"ceiling", placed(Vec3(-0.25f, 1.98f, -0.25f), Vec3(0.5f, 0, 0), Vec3(0, 0, 0.5f))},
+      {"turned", placed(Vec3(0.2f, 0.4f, -0.1f), 2.0f * tx, 1.2f * ty)},
+      {"tiny", placed(Vec3(0.3f, -0.2f, 0.1f), 1e-3f * tx, 2e-3f * ty)},
+      {"huge", placed(Vec3(-500.0f, 10.0f, -500.0f), Vec3(1000.0f, 0, 0), Vec3(0, 0, 1000.0f))},
+      {"far", placed(Vec3(1e4f, 2e4f, -1e4f), 3.0f * tx, 2.0f * ty)},
+      {"general",
+       {Vec3(0.2f, 0.4f, -0.1f), Vec3(2.2f, 0.4f, -0.1f), Vec3(2.7f, 1.9f, -0.1f), Vec3(-0.1f, 1.4f, -0.1f)}},
+  };
+  return cases;
+}
+
+// Reference points all around a quad: close (the spherical-rectangle regime), far (area
+// sampling), grazing its plane, in its plane, and right above its edges.
+std::vector<Vec3> referencePoints(const std::array<Vec3, 4>& v, Rng& rng) {
+  const Vec3 c = 0.25f * (v[0] + v[1] + v[2] + v[3]);
+  const float size = glm::length(v[2] - v[0]);
+  const Vec3 n = glm::normalize(glm::cross(v[1] - v[0], v[2] - v[0]));
+  std::vector<Vec3> refs;
+  for (int i = 0; i < 200; ++i) {
+    const Vec3 dir = sampleUniformSphere(next2(rng));
+    const float dist = size * std::pow(10.0f, -2.0f + 3.0f * rng.uniform());
+    refs.push_back(c + dist * dir);
+  }
+  for (int i = 0; i < 40; ++i) {
+    const Vec2 b = next2(rng);
+    const Vec3 onQuad = v[0] + b.x * (v[1] - v[0]) + b.y * (v[3] - v[0]);
+    const float h = size * std::pow(10.0f, -5.0f + 4.0f * rng.uniform());
+    refs.push_back(onQuad + (i % 2 ? h : -h) * n);                                 // just above or below
+    refs.push_back(c + (3.0f + rng.uniform()) * (onQuad - c) + 1e-4f * size * n);  // grazing
+  }
+  refs.push_back(c);                        // in the plane
+  refs.push_back(v[1] + 1e-3f * size * n);  // over a corner
+  return refs;
+}
+
+void expectSameSample(const Shape& shape, const SolidAngleLanes& lanes, unsigned i,
+                      const std::string& where) {
+  ShapeSample s;
+  float pdf = 0.0f;
+  const Vec3 ref(lanes.ref[0][i], lanes.ref[1][i], lanes.ref[2][i]);
+  const bool ok = shape.sampleSolidAngle(ref, Vec2(lanes.u[0][i], lanes.u[1][i]), s, pdf);
+  ASSERT_EQ(ok, lanes.pdf[i] > 0.0f) << where;
+  if (!ok) return;
+  EXPECT_EQ(pdf, lanes.pdf[i]) << where;
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_EQ(s.p[c], lanes.p[c][i]) << where << " component " << c;
+    EXPECT_EQ(s.n[c], lanes.normal[c][i]) << where << " component " << c;
+  }
+}
+
+TEST(SamplingLanes, EveryLaneOfAQuadEqualsItsSingleCall) {
+  Rng rng(7, 1);
+  const std::array<Vec2, 4> uv = {Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)};
+  for (const QuadCase& qc : quadCases()) {
+    const Quad quad(qc.v, uv);
+    const FlippedShape flipped(std::make_unique<Quad>(qc.v, uv));
+    const std::vector<Vec3> refs = referencePoints(qc.v, rng);
+    for (const Shape* shape : {static_cast<const Shape*>(&quad), static_cast<const Shape*>(&flipped)}) {
+      // Each reference point lands in another lane next to other neighbours on every pass.
+      for (size_t first = 0; first < refs.size(); first += 11) {
+        SolidAngleLanes lanes;
+        lanes.n = unsigned(std::min<size_t>(SolidAngleLanes::kMaxLanes, refs.size() - first));
+        for (unsigned i = 0; i < lanes.n; ++i) lanes.set(i, refs[first + i], next2(rng));
+        lanes.padFrom(lanes.n);
+        shape->sampleSolidAngleLanes(lanes);
+        for (unsigned i = 0; i < lanes.n; ++i)
+          expectSameSample(*shape, lanes, i, qc.name + " ref " + std::to_string(first + i));
+      }
+    }
+  }
+}
+
+// The solid angle of the quad (v0, v1, v2, v3) seen from ref, in double: Van Oosterom and
+// Strackee's formula (1983, IEEE Trans. Biomed. Eng. 30(2)) for each half, accurate however
+// small the angle.
+double exactSolidAngle(const std::array<Vec3, 4>& v, const Vec3& ref) {
+  auto triangle = [&](const Vec3& pa, const Vec3& pb, const Vec3& pc) {
+    const glm::dvec3 r(ref), a = glm::dvec3(pa) - r, b = glm::dvec3(pb) - r, c = glm::dvec3(pc) - r;
+    const double la = glm::length(a), lb = glm::length(b), lc = glm::length(c);
+    const double num = glm::dot(a, glm::cross(b, c));
+    const double den = la * lb * lc + glm::dot(a, b) * lc + glm::dot(a, c) * lb + glm::dot(b, c) * la;
+    return 2.0 * std::abs(std::atan2(num, den));
+  };
+  return triangle(v[0], v[1], v[2]) + triangle(v[0], v[2], v[3]);
+}
+
+// The solid angle both spherical-rectangle implementations divide by, against the exact value,
+// from everywhere around the light, and most of all from near its plane, where the paper's acos
+// form of the angles was wrong by up to 16 times.
+TEST(SamplingLanes, RectangleSolidAngleIsAccurateEvenNearItsPlane) {
+  Rng rng(17, 4);
+  const std::array<Vec2, 4> uv = {Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)};
+  size_t nearPlane = 0;
+  for (const QuadCase& qc : quadCases()) {
+    const Quad quad(qc.v, uv);
+    const Vec3 center = 0.5f * (qc.v[0] + qc.v[2]);
+    // Where the corners' own float rounding is not small against the size (tiny or far-off
+    // rectangles), the solid angle seen from near the plane is not defined by the input to 0.5%:
+    // the four rounded corners are not coplanar to that precision.
+    if (!quad.isRectangle() || maxComponent(glm::abs(center)) > 10.0f * glm::length(qc.v[2] - qc.v[0]))
+      continue;
+    const Vec3 n = glm::normalize(glm::cross(qc.v[1] - qc.v[0], qc.v[3] - qc.v[0]));
+    for (int i = 0; i < 4000; ++i) {
+      // Half the points within 1e-2 of the plane's direction, down to 1e-6.
+      Vec3 dir = sampleUniformSphere(next2(rng));
+      if (i % 2) {
+        dir = glm::normalize(dir - glm::dot(dir, n) * n);
+        dir = glm::normalize(dir + (rng.uniform() < 0.5f ? 1.0f : -1.0f) *
+                                       std::pow(10.0f, -6.0f + 4.0f * rng.uniform()) * n);
+        ++nearPlane;
+      }
+      const Vec3 ref = center + std::sqrt(quad.area()) * (0.2f + 1.7f * rng.uniform()) * dir;
+      const double exact = exactSolidAngle(qc.v, ref);
+      const SphericalRectangle sr(qc.v[0], qc.v[1] - qc.v[0], qc.v[3] - qc.v[0], ref);
+      const std::string where = qc.name + " ref (" + std::to_string(ref.x) + ", " + std::to_string(ref.y) +
+                                ", " + std::to_string(ref.z) + ")";
+      EXPECT_NEAR(sr.solidAngle(), exact, 5e-3 * exact + 2e-6) << where;
+      ShapeSample s;
+      float pdf = 0.0f;
+      const Vec3 d = ref - center;
+      const bool close = glm::dot(d, d) < 4.0f * quad.area();
+      if (close && quad.sampleSolidAngle(ref, next2(rng), s, pdf) &&
+          exact > 1.1 * QuadSampling::kMinSphericalRectangle) {
+        EXPECT_NEAR(1.0 / pdf, exact, 5e-3 * exact + 2e-6) << where;
+      }
+    }
+  }
+  EXPECT_GT(nearPlane, 4000u);
+}
+
+// The kernel against the scalar formulas: accel/spherical_rectangle.cpp where the rectangle is
+// close and subtends enough solid angle, area sampling (PBRT4 eq. A.5.4 and 4.9) elsewhere.
+TEST(SamplingLanes, QuadKernelAgreesWithTheScalarFormulas) {
+  Rng rng(11, 2);
+  const std::array<Vec2, 4> uv = {Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)};
+  size_t spherical = 0, byArea = 0;
+  for (const QuadCase& qc : quadCases()) {
+    const Quad quad(qc.v, uv);
+    const float size = glm::length(qc.v[2] - qc.v[0]);
+    const Vec3 center = 0.5f * (qc.v[0] + qc.v[2]);
+    for (const Vec3& ref : referencePoints(qc.v, rng)) {
+      const Vec2 u = next2(rng);
+      ShapeSample s;
+      float pdf = 0.0f;
+      if (!quad.sampleSolidAngle(ref, u, s, pdf)) continue;
+      const SphericalRectangle sr(qc.v[0], qc.v[1] - qc.v[0], qc.v[3] - qc.v[0], ref);
+      const Vec3 d = ref - center;
+      const bool close = quad.isRectangle() && glm::dot(d, d) < 4.0f * quad.area();
+      // Near the regime's solid-angle threshold the two float evaluations may choose differently.
+      if (close && std::abs(sr.solidAngle() / QuadSampling::kMinSphericalRectangle - 1.0f) < 1e-2f) continue;
+      const std::string where = qc.name + " ref (" + std::to_string(ref.x) + ", " + std::to_string(ref.y) +
+                                ", " + std::to_string(ref.z) + ")";
+      if (close && sr.solidAngle() > QuadSampling::kMinSphericalRectangle) {
+        ++spherical;
+        EXPECT_NEAR(pdf, 1.0f / sr.solidAngle(), 1e-2f * pdf) << where;
+        // The inversion amplifies the arguments' rounding where the rectangle is seen edge-on.
+        const float cosPlane = std::abs(glm::dot(glm::normalize(ref - center), quad.sampleArea(u).n));
+        if (cosPlane > 1e-2f && sr.solidAngle() > 1e-2f) {
+          EXPECT_LE(glm::length(s.p - sr.sample(u)), 1e-3f * size) << where;
+        }
+      } else {
+        ++byArea;
+        const ShapeSample a = quad.sampleArea(u);
+        EXPECT_LE(glm::length(s.p - a.p), 1e-6f * (size + maxComponent(glm::abs(center)))) << where;
+        // d^2 / cos: the sampled point's rounding (a few ulps of the coordinates) relative to
+        // the distance, and the cosine's cancellation (eps / cos) bound the two evaluations' gap.
+        const Vec3 toLight = a.p - ref;
+        const float dist = glm::length(toLight);
+        const float cosLight = std::abs(glm::dot(a.n, toLight)) / dist;
+        const float pointError = 4.0f * 0x1p-24f * (maxComponent(glm::abs(center)) + size) / dist;
+        const float tolerance = 1e-5f + pointError * (4.0f + 2.0f / cosLight) + 1e-6f / cosLight;
+        EXPECT_NEAR(pdf, areaToSolidAnglePdf(1.0f / quad.area(), ref, a.p, a.n), tolerance * pdf) << where;
+      }
+    }
+  }
+  EXPECT_GT(spherical, 300u);
+  EXPECT_GT(byArea, 300u);
+}
+
+TEST(SamplingLanes, AreaLightLanesEqualSingleSamples) {
+  Rng rng(13, 3);
+  const std::array<Vec2, 4> uv = {Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)};
+  const QuadCase ceiling = quadCases()[0];
+  const Quad quad(ceiling.v, uv);
+  const Sphere sphere(Vec3(0.3f, 1.0f, -0.2f), 0.25f);
+  const AreaLight lights[] = {AreaLight(&quad, Color(4.0f, 3.0f, 2.0f)),
+                              AreaLight(&quad, Color(1.0f), /*twoSided=*/true),
+                              AreaLight(&sphere, Color(2.0f))};
+  std::vector<Vec3> refs = referencePoints(ceiling.v, rng);
+  for (const AreaLight& light : lights) {
+    // 37 points: two full blocks of 16 and a partial one.
+    for (size_t first = 0; first + 37 <= refs.size(); first += 37) {
+      std::vector<Vec2> us(37);
+      for (Vec2& u : us) u = next2(rng);
+      std::vector<LightSample> out(37);
+      bool ok[37];
+      light.sampleLanes(&refs[first], us.data(), 37, out.data(), ok);
+      for (size_t i = 0; i < 37; ++i) {
+        LightSample single;
+        ASSERT_EQ(light.sample(refs[first + i], us[i], single), ok[i]) << i;
+        if (!ok[i]) continue;
+        EXPECT_EQ(single.pdf, out[i].pdf);
+        EXPECT_EQ(single.dist, out[i].dist);
+        EXPECT_EQ(single.pError, out[i].pError);
+        for (int c = 0; c < 3; ++c) {
+          EXPECT_EQ(single.wi[c], out[i].wi[c]);
+          EXPECT_EQ(single.p[c], out[i].p[c]);
+          EXPECT_EQ(single.n[c], out[i].n[c]);
+          EXPECT_EQ(single.Li[c], out[i].Li[c]);
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace ember
