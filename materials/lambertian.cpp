@@ -1,6 +1,9 @@
 #include "materials/lambertian.h"
 
 #include "core/sampling.h"
+#include "core/warp_lanes.h"
+
+#include <algorithm>
 
 namespace ember {
 
@@ -16,11 +19,34 @@ float Lambertian::pdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) con
   return cosineHemispherePdf(glm::dot(wi, facingNormal(hit, wo)));
 }
 
+// One live lane of the kernel, so that one vertex and a wave of them get the same direction.
 bool Lambertian::sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float, BsdfSample& out) const {
-  const Frame frame(facingNormal(hit, wo));
-  const Vec3 local = sampleCosineHemisphere(u);
-  out.wi = frame.toWorld(local);
-  out.pdf = cosineHemispherePdf(local.z);
+  CosineLanes lanes;
+  lanes.set(0, facingNormal(hit, wo), u);
+  lanes.padFrom(1);
+  sampleCosineLanes(lanes);
+  return finishSample(hit, wo, lanes.direction(0), lanes.pdf[0], out);
+}
+
+void Lambertian::sampleLanes(const SurfaceHit* const* hits, const Vec3* wo, const Vec2* u, const float*,
+                             size_t n, BsdfSample* out, bool* ok) const {
+  CosineLanes lanes;
+  for (size_t first = 0; first < n; first += CosineLanes::kMaxLanes) {
+    const unsigned count = unsigned(std::min<size_t>(CosineLanes::kMaxLanes, n - first));
+    for (unsigned i = 0; i < count; ++i)
+      lanes.set(i, facingNormal(*hits[first + i], wo[first + i]), u[first + i]);
+    lanes.padFrom(count);
+    sampleCosineLanes(lanes);
+    for (unsigned i = 0; i < count; ++i)
+      ok[first + i] =
+          finishSample(*hits[first + i], wo[first + i], lanes.direction(i), lanes.pdf[i], out[first + i]);
+  }
+}
+
+bool Lambertian::finishSample(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi, float pdf,
+                              BsdfSample& out) const {
+  out.wi = wi;
+  out.pdf = pdf;
   // With a shading normal the sampled direction can dip below the geometric surface: absorb it.
   if (out.pdf <= 0.0f || !sameSide(hit, wo, out.wi)) return false;
   out.weight = reflectance_->eval(hit.uv);

@@ -17,9 +17,15 @@ class Lambertian final : public Material {
   Color eval(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const override;
   float pdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const override;
   bool sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float uLobe, BsdfSample& out) const override;
+  // Blocks of sampleCosineLanes.
+  void sampleLanes(const SurfaceHit* const* hits, const Vec3* wo, const Vec2* u, const float* uLobe, size_t n,
+                   BsdfSample* out, bool* ok) const override;
   bool hasNonDeltaLobes() const override { return !isBlack(reflectance_->maxValue()); }
 
  private:
+  // The sample from the kernel's direction and pdf.
+  bool finishSample(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi, float pdf, BsdfSample& out) const;
+
   std::shared_ptr<const Texture> reflectance_;
 };
 

@@ -34,6 +34,13 @@ class Material {
   }
   // Samples wi; uLobe picks among lobes, u the direction within one. False: the path is absorbed.
   virtual bool sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float uLobe, BsdfSample& out) const = 0;
+  // sample() for n vertices of this material at once: ok[i] = sample(*hits[i], wo[i], u[i],
+  // uLobe[i], out[i]), bit for bit. The default goes vertex by vertex; materials with a lane
+  // kernel (core/warp_lanes.h) override it.
+  virtual void sampleLanes(const SurfaceHit* const* hits, const Vec3* wo, const Vec2* u, const float* uLobe,
+                           size_t n, BsdfSample* out, bool* ok) const {
+    for (size_t i = 0; i < n; ++i) ok[i] = sample(*hits[i], wo[i], u[i], uLobe[i], out[i]);
+  }
 
   // Whether eval can be non-zero, i.e. light sampling is worth a shadow ray.
   virtual bool hasNonDeltaLobes() const { return true; }

@@ -35,6 +35,13 @@ struct Wave {
   std::array<Vec2, kSize> queryU;
   std::array<LightSample, kSize> querySample;
   std::array<bool, kSize> querySampled;
+  // Each vertex's BSDF sample: inputs, then what its material returned.
+  std::array<const SurfaceHit*, kSize> hitOf;
+  std::array<Vec3, kSize> wo;
+  std::array<Vec2, kSize> bsdfU;
+  std::array<float, kSize> bsdfLobe;
+  std::array<BsdfSample, kSize> bsdf;
+  std::array<bool, kSize> bsdfSampled;
   ClosestHitBatch closest{kSize};
   ShadowBatch shadows{kSize};
 };
@@ -76,6 +83,19 @@ void sampleLights(Wave& wave, size_t queries) {
     while (end < queries && (wave.queryKey[end] >> 16) == (wave.queryKey[first] >> 16)) ++end;
     light->sampleLanes(&wave.queryRef[first], &wave.queryU[first], end - first, &wave.querySample[first],
                        &wave.querySampled[first]);
+    first = end;
+  }
+}
+
+// Samples every vertex's BSDF, one Material::sampleLanes call per run of vertices of the same
+// material (the vertices are grouped by geometry, which fixes the material).
+void sampleBsdfs(Wave& wave, size_t vertices) {
+  for (size_t first = 0; first < vertices;) {
+    const Material* material = wave.hits[first].material;
+    size_t end = first + 1;
+    while (end < vertices && wave.hits[end].material == material) ++end;
+    material->sampleLanes(&wave.hitOf[first], &wave.wo[first], &wave.bsdfU[first], &wave.bsdfLobe[first],
+                          end - first, &wave.bsdf[first], &wave.bsdfSampled[first]);
     first = end;
   }
 }
@@ -147,7 +167,15 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
           wave.shadowContribution[wave.shadows.size()] = shadow.contribution;
           wave.shadows.push(shadow.ray);
         }
-        if (path_.scatter(lane.path, wave.hits[v], lane.sampler)) wave.next[next++] = wave.vertexLane[v];
+        wave.hitOf[v] = &wave.hits[v];
+        wave.wo[v] = -lane.path.ray.dir;
+        PathIntegrator::drawBsdfSample(lane.sampler, wave.bsdfU[v], wave.bsdfLobe[v]);
+      }
+      sampleBsdfs(wave, vertices);
+      for (size_t v = 0; v < vertices; ++v) {
+        Wave::Lane& lane = wave.lanes[wave.vertexLane[v]];
+        if (path_.followBsdfSample(lane.path, wave.hits[v], wave.bsdf[v], wave.bsdfSampled[v], lane.sampler))
+          wave.next[next++] = wave.vertexLane[v];
       }
 
       wave.shadows.trace(scene.accel(), traversal_);

@@ -102,9 +102,17 @@ bool PathIntegrator::arrive(const Scene& scene, PathState& path, const SurfaceHi
 }
 
 bool PathIntegrator::scatter(PathState& path, const SurfaceHit& hit, Sampler& sampler) const {
+  Vec2 u;
+  float uLobe;
+  drawBsdfSample(sampler, u, uLobe);
   BsdfSample bs;
-  const Vec2 u = sampler.get2D();
-  if (!hit.material->sample(hit, -path.ray.dir, u, sampler.get1D(), bs)) return false;
+  const bool sampled = hit.material->sample(hit, -path.ray.dir, u, uLobe, bs);
+  return followBsdfSample(path, hit, bs, sampled, sampler);
+}
+
+bool PathIntegrator::followBsdfSample(PathState& path, const SurfaceHit& hit, const BsdfSample& bs,
+                                      bool sampled, Sampler& sampler) const {
+  if (!sampled) return false;
   path.throughput *= bs.weight;
   if (isBlack(path.throughput)) return false;
   path.previousDelta = bs.delta;

@@ -87,8 +87,16 @@ class PathIntegrator final : public Integrator {
   // The shadow ray for the light's sample `ls` (valid when `sampled`); false if there is none.
   bool shadowFor(const SurfaceHit& hit, const PathState& path, const LightPick& pick, const LightSample& ls,
                  bool sampled, PathStats& stats, ShadowRequest& shadow) const;
-  // Samples the path's next ray and applies Russian roulette; false if the path ends.
+  // Samples the path's next ray and applies Russian roulette; false if the path ends. In steps:
+  // the BSDF's random numbers, the material's sample (Material::sample, or sampleLanes for many
+  // vertices), then followBsdfSample.
   bool scatter(PathState& path, const SurfaceHit& hit, Sampler& sampler) const;
+  static void drawBsdfSample(Sampler& sampler, Vec2& u, float& uLobe) {
+    u = sampler.get2D();
+    uLobe = sampler.get1D();
+  }
+  bool followBsdfSample(PathState& path, const SurfaceHit& hit, const BsdfSample& bs, bool sampled,
+                        Sampler& sampler) const;
 
  private:
   // Weight of emission that a BSDF-sampled direction (density bsdfPdf) found, where light sampling

@@ -10,6 +10,8 @@
 #include "accel/triangle.h"
 #include "core/rng.h"
 #include "core/sampling.h"
+#include "core/warp_lanes.h"
+#include "materials/lambertian.h"
 #include "renderer/light.h"
 
 #include <gtest/gtest.h>
@@ -256,6 +258,79 @@ TEST(SamplingLanes, AreaLightLanesEqualSingleSamples) {
       }
     }
   }
+}
+
+// The cosine kernel against the scalar warp (core/sampling.h) and frame (core/math.h): the same
+// directions to float precision (SIMD sin and cos are within a few ulps of libm's), unit length,
+// in the normal's hemisphere, with pdf cos / pi, for normals along every axis and sign (the
+// frame's branch) and u at the square's centre, edges and diagonals (the concentric map's).
+TEST(SamplingLanes, CosineKernelAgreesWithTheScalarWarp) {
+  Rng rng(19, 5);
+  std::vector<Vec3> normals = {Vec3(0, 0, 1), Vec3(0, 0, -1), Vec3(1, 0, 0), Vec3(0, -1, 0),
+                               glm::normalize(Vec3(1e-7f, 0.0f, -1.0f))};
+  for (int i = 0; i < 200; ++i) normals.push_back(sampleUniformSphere(next2(rng)));
+  std::vector<Vec2> us = {Vec2(0.5f),         Vec2(0.0f),         Vec2(0.99999994f),      Vec2(0.5f, 0.0f),
+                          Vec2(0.25f, 0.75f), Vec2(0.75f, 0.75f), Vec2(0.5f, 0.99999994f)};
+  for (int i = 0; i < 400; ++i) us.push_back(next2(rng));
+  CosineLanes lanes;
+  for (size_t k = 0; k < normals.size() * 4; k += CosineLanes::kMaxLanes) {
+    for (unsigned i = 0; i < CosineLanes::kMaxLanes; ++i)
+      lanes.set(i, normals[(k + i) % normals.size()], us[(k + 7 * i) % us.size()]);
+    sampleCosineLanes(lanes);
+    for (unsigned i = 0; i < CosineLanes::kMaxLanes; ++i) {
+      const Vec3 n = normals[(k + i) % normals.size()];
+      const Vec3 local = sampleCosineHemisphere(us[(k + 7 * i) % us.size()]);
+      const Vec3 expected = Frame(n).toWorld(local);
+      const Vec3 wi = lanes.direction(i);
+      // z = sqrt(1 - x^2 - y^2) cancels at the disc's rim: grazing directions carry eps / z.
+      const float tolerance = 2e-6f + 4e-7f / std::max(local.z, 1e-6f);
+      EXPECT_LE(glm::length(wi - expected), tolerance) << "lane " << i << " of block " << k;
+      EXPECT_NEAR(glm::length(wi), 1.0f, 2e-6f);
+      EXPECT_GE(glm::dot(wi, n), -1e-6f);
+      EXPECT_NEAR(lanes.pdf[i], cosineHemispherePdf(local.z), tolerance * kInvPi);
+      EXPECT_NEAR(lanes.pdf[i], std::max(0.0f, glm::dot(wi, n)) * kInvPi, 2e-6f);
+    }
+  }
+}
+
+TEST(SamplingLanes, LambertianLanesEqualSingleSamples) {
+  Rng rng(23, 6);
+  const Lambertian material(std::make_shared<ConstantTexture>(Color(0.7f, 0.5f, 0.3f)));
+  std::vector<SurfaceHit> hits(37);
+  std::vector<const SurfaceHit*> hitOf;
+  std::vector<Vec3> wo;
+  std::vector<Vec2> u;
+  std::vector<float> uLobe;
+  for (SurfaceHit& hit : hits) {
+    hit.p = Vec3(rng.uniform(), rng.uniform(), rng.uniform());
+    hit.ng = sampleUniformSphere(next2(rng));
+    // Shading normals tilted off the geometric one: some samples dip below the surface.
+    hit.ns = glm::normalize(hit.ng + 0.6f * sampleUniformSphere(next2(rng)));
+    if (glm::dot(hit.ns, hit.ng) < 0.0f) hit.ns = -hit.ns;
+    hitOf.push_back(&hit);
+    wo.push_back(sampleUniformSphere(next2(rng)));  // either side
+    u.push_back(next2(rng));
+    uLobe.push_back(rng.uniform());
+  }
+  std::vector<BsdfSample> out(hits.size());
+  bool ok[37];
+  material.sampleLanes(hitOf.data(), wo.data(), u.data(), uLobe.data(), hits.size(), out.data(), ok);
+  size_t absorbed = 0;
+  for (size_t i = 0; i < hits.size(); ++i) {
+    BsdfSample single;
+    ASSERT_EQ(material.sample(hits[i], wo[i], u[i], uLobe[i], single), ok[i]) << i;
+    if (!ok[i]) {
+      ++absorbed;
+      continue;
+    }
+    EXPECT_EQ(single.pdf, out[i].pdf);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_EQ(single.wi[c], out[i].wi[c]);
+      EXPECT_EQ(single.weight[c], out[i].weight[c]);
+    }
+  }
+  EXPECT_GT(absorbed, 0u);
+  EXPECT_LT(absorbed, hits.size() / 2);
 }
 
 }  // namespace
