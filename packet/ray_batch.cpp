@@ -28,11 +28,18 @@ void writeRay(Packet& p, size_t lane, const Ray& given) {
   p.dir_x[lane] = ray.dir.x;
   p.dir_y[lane] = ray.dir.y;
   p.dir_z[lane] = ray.dir.z;
-  p.time[lane] = 0.0f;
   p.tfar[lane] = ray.tMax;
-  p.mask[lane] = 0xFFFFFFFFu;  // Debian's Embree is built with ray masks: 0 would miss everything
-  p.id[lane] = unsigned(lane);
-  p.flags[lane] = 0;
+}
+
+// The fields no ray changes, written once per packet at construction.
+template <typename Packet>
+void initFixedFields(Packet& p) {
+  for (size_t lane = 0; lane < kLanes; ++lane) {
+    p.time[lane] = 0.0f;
+    p.mask[lane] = 0xFFFFFFFFu;  // Debian's Embree is built with ray masks: 0 would miss everything
+    p.id[lane] = unsigned(lane);
+    p.flags[lane] = 0;
+  }
 }
 
 // Lanes [0, count) of a packet are valid. Packets after the last are never traced.
@@ -53,7 +60,9 @@ void disableLanes(Packet& p, size_t from) {
 }  // namespace
 
 ClosestHitBatch::ClosestHitBatch(size_t capacity)
-    : capacity_(capacity), packets_(new RTCRayHit16[packetsFor(capacity)]) {}
+    : capacity_(capacity), packets_(new RTCRayHit16[packetsFor(capacity)]) {
+  for (size_t k = 0; k < packetsFor(capacity); ++k) initFixedFields(packets_[k].ray);
+}
 
 void ClosestHitBatch::push(const Ray& ray) {
   if (size_ == capacity_) throw std::logic_error("ClosestHitBatch overflow");
@@ -98,7 +107,9 @@ bool ClosestHitBatch::hit(size_t i, RawHit& out) const {
 }
 
 ShadowBatch::ShadowBatch(size_t capacity)
-    : capacity_(capacity), packets_(new RTCRay16[packetsFor(capacity)]) {}
+    : capacity_(capacity), packets_(new RTCRay16[packetsFor(capacity)]) {
+  for (size_t k = 0; k < packetsFor(capacity); ++k) initFixedFields(packets_[k]);
+}
 
 void ShadowBatch::push(const Ray& ray) {
   if (size_ == capacity_) throw std::logic_error("ShadowBatch overflow");

@@ -114,6 +114,8 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
   for (uint64_t first = 0; first < total; first += Wave::kSize) {
     const size_t count = size_t(std::min<uint64_t>(Wave::kSize, total - first));
     size_t active = 0;
+    // Each ray goes into the next batch where it is made, while its path is in cache.
+    wave.closest.clear();
     for (size_t i = 0; i < count; ++i) {
       const uint64_t k = first + i;
       const uint64_t s = k / pixels, inTile = k % pixels;
@@ -122,13 +124,13 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
       lane.y = work.y0 + int(inTile / uint64_t(tileWidth));
       lane.sampler =
           Sampler(work.sampler, work.seed, uint64_t(lane.y) * width + uint64_t(lane.x), work.firstSample + s);
-      if (path_.start(cameraRay(scene, lane.x, lane.y, lane.sampler), lane.path))
+      if (path_.start(cameraRay(scene, lane.x, lane.y, lane.sampler), lane.path)) {
         wave.active[active++] = uint16_t(i);
+        wave.closest.push(lane.path.ray);
+      }
     }
 
     while (active > 0) {
-      wave.closest.clear();
-      for (size_t a = 0; a < active; ++a) wave.closest.push(wave.lanes[wave.active[a]].path.ray);
       stats.rays += active;
       wave.closest.trace(scene.accel(), traversal_);
 
@@ -172,10 +174,14 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
         PathIntegrator::drawBsdfSample(lane.sampler, wave.bsdfU[v], wave.bsdfLobe[v]);
       }
       sampleBsdfs(wave, vertices);
+      wave.closest.clear();  // its hits are all read
       for (size_t v = 0; v < vertices; ++v) {
         Wave::Lane& lane = wave.lanes[wave.vertexLane[v]];
-        if (path_.followBsdfSample(lane.path, wave.hits[v], wave.bsdf[v], wave.bsdfSampled[v], lane.sampler))
+        if (path_.followBsdfSample(lane.path, wave.hits[v], wave.bsdf[v], wave.bsdfSampled[v],
+                                   lane.sampler)) {
           wave.next[next++] = wave.vertexLane[v];
+          wave.closest.push(lane.path.ray);
+        }
       }
 
       wave.shadows.trace(scene.accel(), traversal_);
