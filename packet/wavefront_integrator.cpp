@@ -1,5 +1,7 @@
 #include "packet/wavefront_integrator.h"
 
+#include "renderer/sampler_lanes.h"
+
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -42,6 +44,12 @@ struct Wave {
   std::array<float, kSize> bsdfLobe;
   std::array<BsdfSample, kSize> bsdf;
   std::array<bool, kSize> bsdfSampled;
+  // Samplers whose next request the bounce draws together (renderer/sampler_lanes.h), and the
+  // numbers drawn; for the light choice, the vertex each belongs to.
+  std::array<Sampler*, kSize> samplerOf;
+  std::array<float, kSize> drawn1D;
+  std::array<Vec2, kSize> drawn2D;
+  std::array<uint16_t, kSize> lightVertex;
   ClosestHitBatch closest{kSize};
   ShadowBatch shadows{kSize};
 };
@@ -124,7 +132,12 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
       lane.y = work.y0 + int(inTile / uint64_t(tileWidth));
       lane.sampler =
           Sampler(work.sampler, work.seed, uint64_t(lane.y) * width + uint64_t(lane.x), work.firstSample + s);
-      if (path_.start(cameraRay(scene, lane.x, lane.y, lane.sampler), lane.path)) {
+      wave.samplerOf[i] = &lane.sampler;
+    }
+    draw2DLanes(wave.samplerOf.data(), count, wave.drawn2D.data());  // the pixel jitter
+    for (size_t i = 0; i < count; ++i) {
+      Wave::Lane& lane = wave.lanes[i];
+      if (path_.start(cameraRay(scene, lane.x, lane.y, wave.drawn2D[i]), lane.path)) {
         wave.active[active++] = uint16_t(i);
         wave.closest.push(lane.path.ray);
       }
@@ -137,7 +150,7 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
       // The steps of PathIntegrator::onHit, each for the whole bounce: arrival and the light
       // choice, then the lights' samples, then shadow rays and scattering.
       groupByGeometry(wave, active, scene.geometryCount());
-      size_t vertices = 0, queries = 0;
+      size_t vertices = 0, lightDraws = 0, queries = 0;
       for (size_t o = 0; o < active; ++o) {
         const size_t a = wave.order[o];
         Wave::Lane& lane = wave.lanes[wave.active[a]];
@@ -151,9 +164,19 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
         if (!path_.arrive(scene, lane.path, hit, stats)) continue;
         wave.vertexLane[vertices] = wave.active[a];
         wave.queryOf[vertices] = -1;
-        if (path_.pickLight(scene, hit, lane.sampler, wave.picks[vertices]))
-          wave.queryKey[queries++] = uint64_t(wave.picks[vertices].light->samplerIndex) << 16 | vertices;
+        if (path_.samplesLights(scene, hit)) {
+          wave.lightVertex[lightDraws] = uint16_t(vertices);
+          wave.samplerOf[lightDraws++] = &lane.sampler;
+        }
         ++vertices;
+      }
+      // pickLight for the bounce: its 1D, then its 2D request, then the choice.
+      draw1DLanes(wave.samplerOf.data(), lightDraws, wave.drawn1D.data());
+      draw2DLanes(wave.samplerOf.data(), lightDraws, wave.drawn2D.data());
+      for (size_t j = 0; j < lightDraws; ++j) {
+        const size_t v = wave.lightVertex[j];
+        if (PathIntegrator::pickLightWith(scene, wave.drawn1D[j], wave.drawn2D[j], wave.picks[v]))
+          wave.queryKey[queries++] = uint64_t(wave.picks[v].light->samplerIndex) << 16 | v;
       }
       sampleLights(wave, queries);
 
@@ -171,8 +194,11 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
         }
         wave.hitOf[v] = &wave.hits[v];
         wave.wo[v] = -lane.path.ray.dir;
-        PathIntegrator::drawBsdfSample(lane.sampler, wave.bsdfU[v], wave.bsdfLobe[v]);
+        wave.samplerOf[v] = &lane.sampler;
       }
+      // PathIntegrator::drawBsdfSample for the bounce: its 2D, then its 1D request.
+      draw2DLanes(wave.samplerOf.data(), vertices, wave.bsdfU.data());
+      draw1DLanes(wave.samplerOf.data(), vertices, wave.bsdfLobe.data());
       sampleBsdfs(wave, vertices);
       wave.closest.clear();  // its hits are all read
       for (size_t v = 0; v < vertices; ++v) {

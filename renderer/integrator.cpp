@@ -3,7 +3,10 @@
 namespace ember {
 
 Ray cameraRay(const Scene& scene, int x, int y, Sampler& sampler) {
-  const Vec2 jitter = sampler.get2D();
+  return cameraRay(scene, x, y, sampler.get2D());
+}
+
+Ray cameraRay(const Scene& scene, int x, int y, Vec2 jitter) {
   return scene.camera().generateRay(float(x) + jitter.x, float(y) + jitter.y);
 }
 

@@ -50,6 +50,8 @@ class Integrator {
 // The camera sample (pixel, index) of a tile: its sampler, and the ray through its jittered
 // raster position (the sampler's first 2D request).
 Ray cameraRay(const Scene& scene, int x, int y, Sampler& sampler);
+// The same ray for the pixel jitter the sampler's first request gave.
+Ray cameraRay(const Scene& scene, int x, int y, Vec2 jitter);
 
 // Adds a finished sample to the film, or counts it in stats.nonFinite if it is NaN or infinite.
 void addToFilm(Film& film, int x, int y, const Color& L, PathStats& stats);

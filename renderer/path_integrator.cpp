@@ -4,13 +4,21 @@
 
 namespace ember {
 
+bool PathIntegrator::samplesLights(const Scene& scene, const SurfaceHit& hit) const {
+  return strategy_ != Strategy::Bsdf && hit.material->hasNonDeltaLobes() && !scene.lightSampler().empty();
+}
+
+bool PathIntegrator::pickLightWith(const Scene& scene, float uPick, Vec2 u, LightPick& pick) {
+  pick.light = scene.lightSampler().sample(uPick, pick.pmf);
+  pick.u = u;
+  return pick.light != nullptr;
+}
+
 bool PathIntegrator::pickLight(const Scene& scene, const SurfaceHit& hit, Sampler& sampler,
                                LightPick& pick) const {
-  const LightSampler& lights = scene.lightSampler();
-  if (strategy_ == Strategy::Bsdf || !hit.material->hasNonDeltaLobes() || lights.empty()) return false;
-  pick.light = lights.sample(sampler.get1D(), pick.pmf);
-  pick.u = sampler.get2D();
-  return pick.light != nullptr;
+  if (!samplesLights(scene, hit)) return false;
+  const float uPick = sampler.get1D();
+  return pickLightWith(scene, uPick, sampler.get2D(), pick);
 }
 
 bool PathIntegrator::shadowFor(const SurfaceHit& hit, const PathState& path, const LightPick& pick,

@@ -83,7 +83,11 @@ class PathIntegrator final : public Integrator {
   // Emission and absorption on arrival; false if the path ends here without scattering.
   bool arrive(const Scene& scene, PathState& path, const SurfaceHit& hit, PathStats& stats) const;
   // Chooses the light to sample and draws its random numbers; false if the vertex samples none.
+  // In steps: whether the vertex samples a light at all (then it draws a 1D and a 2D request),
+  // and the choice from those numbers.
   bool pickLight(const Scene& scene, const SurfaceHit& hit, Sampler& sampler, LightPick& pick) const;
+  bool samplesLights(const Scene& scene, const SurfaceHit& hit) const;
+  static bool pickLightWith(const Scene& scene, float uPick, Vec2 u, LightPick& pick);
   // The shadow ray for the light's sample `ls` (valid when `sampled`); false if there is none.
   bool shadowFor(const SurfaceHit& hit, const PathState& path, const LightPick& pick, const LightSample& ls,
                  bool sampled, PathStats& stats, ShadowRequest& shadow) const;

@@ -55,6 +55,14 @@ class Sampler {
   // the shared scenes and costs about a third as much time.
   static constexpr uint32_t kMaxSobolDimensions = 8;
 
+  // For renderer/sampler_lanes.h, which draws the Sobol requests of many samplers at once: whether
+  // the next request is a Sobol dimension, the state it is computed from, and the step past it.
+  bool nextIsSobol() const { return sobol_ && dimension_ < kMaxSobolDimensions; }
+  uint32_t pixelSeed() const { return pixelSeed_; }
+  uint32_t sampleIndex() const { return index_; }
+  uint32_t dimension() const { return dimension_; }
+  void skipDimension() { ++dimension_; }
+
  private:
   static uint32_t reverseBits(uint32_t x) {
     x = __builtin_bswap32(x);  // bytes in one instruction, then bits within each byte

@@ -13,6 +13,7 @@
 #include "core/warp_lanes.h"
 #include "materials/lambertian.h"
 #include "renderer/light.h"
+#include "renderer/sampler_lanes.h"
 
 #include <gtest/gtest.h>
 
@@ -331,6 +332,46 @@ TEST(SamplingLanes, LambertianLanesEqualSingleSamples) {
   }
   EXPECT_GT(absorbed, 0u);
   EXPECT_LT(absorbed, hits.size() / 2);
+}
+
+// The Sobol kernel is integer arithmetic: equal to the scalar sampler bit for bit, for samplers at
+// every dimension (below, at and past the Sobol ones), both sampler types, any pixel and index,
+// and any run length (partial blocks, blocks interrupted by PCG32 lanes).
+TEST(SamplingLanes, SamplerLanesEqualTheScalarSampler) {
+  Rng rng(29, 7);
+  for (const SamplerType type : {SamplerType::Sobol, SamplerType::Independent}) {
+    std::vector<Sampler> lanes, reference;
+    for (int i = 0; i < 53; ++i) {
+      const uint64_t pixel = uint64_t(rng.nextU32()) * (i % 3 == 0 ? 1u : 977u);
+      const uint64_t index = i % 5 == 0 ? uint64_t(i) : uint64_t(rng.nextU32());
+      lanes.emplace_back(type, 1234 + uint64_t(i % 2), pixel, index);
+      reference.emplace_back(type, 1234 + uint64_t(i % 2), pixel, index);
+      // Lanes start at different dimensions, as a bounce's paths do.
+      for (int k = 0; k < i % 11; ++k) {
+        lanes.back().get1D();
+        reference.back().get1D();
+      }
+    }
+    std::vector<Sampler*> pointers;
+    for (Sampler& s : lanes) pointers.push_back(&s);
+    for (int request = 0; request < 12; ++request) {
+      const size_t n = request % 4 == 3 ? 17 : lanes.size();  // some requests for a prefix only
+      if (request % 2 == 0) {
+        std::vector<Vec2> out(n);
+        draw2DLanes(pointers.data(), n, out.data());
+        for (size_t i = 0; i < n; ++i) {
+          const Vec2 expected = reference[i].get2D();
+          EXPECT_EQ(expected.x, out[i].x) << "request " << request << " lane " << i;
+          EXPECT_EQ(expected.y, out[i].y) << "request " << request << " lane " << i;
+        }
+      } else {
+        std::vector<float> out(n);
+        draw1DLanes(pointers.data(), n, out.data());
+        for (size_t i = 0; i < n; ++i)
+          EXPECT_EQ(reference[i].get1D(), out[i]) << "request " << request << " lane " << i;
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -1,0 +1,31 @@
+// The Sobol sampler's requests for many samplers at once (a bounce of a wave,
+// packet/wavefront_integrator.cpp): each sampler's next 1D or 2D request, exactly the value its
+// get1D / get2D would return. The Owen-scrambling hashes (renderer/sampler.h) are integer
+// arithmetic, so the Highway kernel (64-bit lanes, the widest ISA the CPU has) equals the scalar
+// code bit for bit by construction (tests/test_sampling_lanes.cpp); requests past the Sobol
+// dimensions, and the independent sampler's, come from each sampler's own PCG32 stream.
+#pragma once
+
+#include "renderer/sampler.h"
+
+#include <cstddef>
+#include <cstdint>
+
+namespace ember {
+
+// Up to kBlock Sobol requests, structure of arrays: the inputs of Sampler::get1D / get2D and
+// their 32-bit results before the conversion to float.
+struct SobolBlock {
+  static constexpr size_t kBlock = 16;
+  alignas(64) uint64_t seedKey[kBlock];  // pixelSeed << 32 | dimension, hashed by mix64
+  alignas(64) uint64_t index[kBlock];
+  alignas(64) uint64_t first[kBlock];
+  alignas(64) uint64_t second[kBlock];
+};
+
+// out[i] = samplers[i]->get1D() for i < n.
+void draw1DLanes(Sampler* const* samplers, size_t n, float* out);
+// out[i] = samplers[i]->get2D() for i < n.
+void draw2DLanes(Sampler* const* samplers, size_t n, Vec2* out);
+
+}  // namespace ember
