@@ -49,7 +49,7 @@ class FlippedShape final : public Shape {
   void sampleSolidAngleLanes(SolidAngleLanes& lanes) const override {
     inner_->sampleSolidAngleLanes(lanes);
     for (auto& component : lanes.normal)
-      for (float& c : component) c = -c;
+      for (unsigned i = 0; i < lanes.n; ++i) component[i] = -component[i];
   }
   float pdfSolidAngle(const Vec3& ref, const Vec3& p, const Vec3& n) const override {
     return inner_->pdfSolidAngle(ref, p, -n);

@@ -94,7 +94,10 @@ static bool isRectangleQuad(const std::array<Vec3, 4>& v) {
 // Solid-angle sampling pays where the light subtends a wide angle: there the 1 / d^2 and cosine
 // factors vary across it and area sampling wastes samples. From farther than twice the light's
 // size area sampling is nearly as good and far cheaper (no inverse trigonometry), so it is used
-// there; the choice depends on the reference point alone, so sample and pdf always agree.
+// there; the choice depends on the reference point alone. (The sampling kernel and pdfSolidAngle
+// evaluate the solid-angle threshold with different float code, so within rounding of it they may
+// disagree on the regime; both densities are then nearly equal, and the MIS weights sum to 1
+// within that rounding.)
 static bool useSphericalRectangle(const Vec3& ref, const Vec3& center, float area) {
   const Vec3 d = ref - center;
   return glm::dot(d, d) < 4.0f * area;

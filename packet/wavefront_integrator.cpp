@@ -26,6 +26,7 @@ struct Wave {
   std::array<uint16_t, kSize> order;     // batch indices of the bounce, grouped by geometry
   std::array<uint32_t, kSize> groupKey;  // geomID + 1 of each batch index's hit, 0 for a miss
   std::vector<uint16_t> groupStart;      // counting-sort buckets, sized once per scene
+  std::array<uint64_t, kSize> sortKey;   // (geomID + 1) << 16 | batch index, for many geometries
   // The bounce's scattering vertices (index s), in shading order.
   std::array<uint16_t, kSize> vertexLane;
   std::array<SurfaceHit, kSize> hits;
@@ -65,6 +66,14 @@ Wave& threadWave() {
 // Each lane's result does not depend on the order lanes are shaded in.
 void groupByGeometry(Wave& wave, size_t active, size_t geometries) {
   const size_t buckets = geometries + 1;
+  // With many geometries, clearing the buckets would cost more than sorting the wave's keys.
+  if (buckets > 4 * Wave::kSize) {
+    for (size_t a = 0; a < active; ++a)
+      wave.sortKey[a] = uint64_t(wave.closest.geometryOf(a) + 1u) << 16 | a;  // misses (0) first
+    std::sort(wave.sortKey.begin(), wave.sortKey.begin() + ptrdiff_t(active));
+    for (size_t o = 0; o < active; ++o) wave.order[o] = uint16_t(wave.sortKey[o] & 0xffffu);
+    return;
+  }
   if (wave.groupStart.size() < buckets + 1) wave.groupStart.assign(buckets + 1, 0);
   std::fill(wave.groupStart.begin(), wave.groupStart.begin() + ptrdiff_t(buckets + 1), uint16_t(0));
   for (size_t a = 0; a < active; ++a) {

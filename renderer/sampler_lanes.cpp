@@ -14,7 +14,7 @@ namespace hn = hwy::HWY_NAMESPACE;
 
 // 32-bit arithmetic in 64-bit lanes: the products of Burley's hash need the low 32 bits of 32 x
 // 32-bit multiplies, which 64-bit lanes hold exactly, and mix64 needs 64-bit lanes anyway.
-using D = hn::ScalableTag<uint64_t>;
+using D = hn::CappedTag<uint64_t, SobolBlock::kBlock>;  // never wider than a block
 using V = hn::Vec<D>;
 
 HWY_INLINE V low32(D d, V x) {

@@ -133,6 +133,44 @@ TEST(Wavefront, SameImageAsScalarForEveryEmitterAndLight) {
   std::filesystem::remove(path);
 }
 
+// More geometries than the counting sort's buckets pay for (packet/wavefront_integrator.cpp,
+// groupByGeometry sorts the wave's keys instead), many of them lights: 1,200 small spheres and
+// quads, every third one emitting, over a floor.
+TEST(Wavefront, SameImageAsScalarWithThousandsOfGeometries) {
+  const std::string path = (std::filesystem::temp_directory_path() / "ember_wavefront_many.json").string();
+  {
+    std::ofstream f(path);
+    f << R"({"image": {"width": 24, "height": 20},
+      "camera": {"origin": [0, 3, 6], "target": [0, 0, 0], "up": [0, 1, 0], "fov_y_deg": 50},
+      "render": {"max_depth": 5, "rr_depth": 2},
+      "materials": {"white": {"type": "diffuse", "reflectance": [0.7, 0.7, 0.7]}},
+      "shapes": [{"type": "quad", "material": "white", "vertices": [[-5, 0, -5], [5, 0, -5], [5, 0, 5], [-5, 0, 5]]})";
+    for (int i = 0; i < 1200; ++i) {
+      const float x = -4.0f + 8.0f * float(i % 40) / 39.0f, z = -4.0f + 8.0f * float(i / 40) / 29.0f;
+      const std::string emit = i % 3 == 0 ? R"(, "emission": [1, 0.8, 0.6])" : R"(, "material": "white")";
+      if (i % 2 == 0) {
+        f << R"(, {"type": "sphere", "center": [)" << x << ", 0.3, " << z << R"(], "radius": 0.08)" << emit
+          << "}";
+      } else {
+        f << R"(, {"type": "quad", "vertices": [[)" << x << ", 0.6, " << z << "], [" << x + 0.1f << ", 0.6, "
+          << z << "], [" << x + 0.1f << ", 0.6, " << z + 0.1f << "], [" << x << ", 0.6, " << z + 0.1f << "]]"
+          << emit << "}";
+      }
+    }
+    f << "]}";
+  }
+  Scene scene;
+  try {
+    scene = loadScene(path);
+  } catch (const std::exception& e) {
+    FAIL() << e.what();
+  }
+  scene.build();
+  ASSERT_GT(scene.geometryCount(), 4 * WavefrontIntegrator::kWaveSize);
+  expectKernelsAgree(scene, "1,200 geometries", RenderCase{2, 16, 2, 0});
+  std::filesystem::remove(path);
+}
+
 // Triangle meshes (Embree's own packet kernels, alpha-tested, normal-mapped) beside shapes.
 TEST(Wavefront, SameImageAsScalarOnGltfMeshes) {
   for (const char* name : {"scenes/gltf/bricks.gltf", "scenes/gltf/sphere-grid.gltf"}) {
