@@ -26,9 +26,13 @@ struct SolidAngleLanes {
     ref[0][i] = r.x, ref[1][i] = r.y, ref[2][i] = r.z;
     u[0][i] = uu.x, u[1][i] = uu.y;
   }
-  // Lanes from n up get harmless inputs: the kernels compute all kMaxLanes.
+  // Lanes from `from` up repeat lane 0 (or a point at the origin if there is none): the kernels
+  // compute all kMaxLanes, and copies of a live lane never send a block down a branch (the
+  // spherical rectangle's) that no live lane needs.
   void padFrom(unsigned from) {
-    for (unsigned i = from; i < kMaxLanes; ++i) set(i, Vec3(0.0f), Vec2(0.5f));
+    const Vec3 r = from > 0 ? Vec3(ref[0][0], ref[1][0], ref[2][0]) : Vec3(0.0f);
+    const Vec2 uu = from > 0 ? Vec2(u[0][0], u[1][0]) : Vec2(0.5f);
+    for (unsigned i = from; i < kMaxLanes; ++i) set(i, r, uu);
   }
   Vec3 point(unsigned i) const { return {p[0][i], p[1][i], p[2][i]}; }
   Vec3 normalAt(unsigned i) const { return {normal[0][i], normal[1][i], normal[2][i]}; }

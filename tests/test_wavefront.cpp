@@ -53,6 +53,12 @@ void expectIdentical(const Film& a, const Film& b, const std::string& what) {
   EXPECT_EQ(differing, 0u) << what << ": " << differing << " channels differ, first in pixel " << first;
 }
 
+Scene loadBuilt(const std::string& path) {
+  Scene scene = loadScene(path);
+  scene.build();
+  return scene;
+}
+
 Scene loadSmall(const std::string& path, int width, int height) {
   Scene scene = loadScene(path);
   scene.settings.width = width;
@@ -119,13 +125,7 @@ TEST(Wavefront, SameImageAsScalarForEveryEmitterAndLight) {
       {"type": "directional", "direction": [0.3, -1, 0.2], "irradiance": [0.5, 0.5, 0.4]}
     ]
   })";
-  Scene scene;
-  try {
-    scene = loadScene(path);
-  } catch (const std::exception& e) {
-    FAIL() << e.what();
-  }
-  scene.build();
+  Scene scene = loadBuilt(path);  // a load error fails the test with its message
   for (Strategy strategy : {Strategy::Mis, Strategy::Bsdf, Strategy::Light}) {
     scene.settings.strategy = strategy;
     expectKernelsAgree(scene, std::string("emitters, ") + std::string(strategyName(strategy)));
@@ -159,13 +159,7 @@ TEST(Wavefront, SameImageAsScalarWithThousandsOfGeometries) {
     }
     f << "]}";
   }
-  Scene scene;
-  try {
-    scene = loadScene(path);
-  } catch (const std::exception& e) {
-    FAIL() << e.what();
-  }
-  scene.build();
+  Scene scene = loadBuilt(path);  // a load error fails the test with its message
   ASSERT_GT(scene.geometryCount(), 4 * WavefrontIntegrator::kWaveSize);
   expectKernelsAgree(scene, "1,200 geometries", RenderCase{2, 16, 2, 0});
   std::filesystem::remove(path);
