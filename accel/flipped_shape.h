@@ -20,6 +20,13 @@ class FlippedShape final : public Shape {
     return true;
   }
   uint32_t candidateLanes(const RayLanes& rays) const override { return inner_->candidateLanes(rays); }
+  void intersectLanes(const RayLanes& rays, LaneHits& out) const override {
+    inner_->intersectLanes(rays, out);
+    for (uint32_t bits = out.mask; bits != 0; bits &= bits - 1) {
+      LocalHit& h = out.hit[__builtin_ctz(bits)];
+      h.ng = -h.ng;
+    }
+  }
   Vec2 surfaceUv(const LocalHit& hit) const override {
     LocalHit original = hit;
     original.ng = -hit.ng;

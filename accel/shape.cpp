@@ -9,6 +9,14 @@ uint32_t Shape::candidateLanes(const RayLanes& rays) const {
   return bits;
 }
 
+void Shape::intersectLanes(const RayLanes& rays, LaneHits& out) const {
+  out.mask = 0;
+  for (uint32_t bits = candidateLanes(rays); bits != 0; bits &= bits - 1) {
+    const unsigned i = unsigned(__builtin_ctz(bits));
+    if (intersect(rays.ray(i), rays.tnear[i], rays.tfar[i], out.hit[i])) out.mask |= 1u << i;
+  }
+}
+
 float areaToSolidAnglePdf(float pdfArea, const Vec3& ref, const Vec3& p, const Vec3& n) {
   const Vec3 d = p - ref;
   const float dist2 = glm::dot(d, d);

@@ -35,6 +35,13 @@ struct LocalHit {
   Vec2 uv{0.0f};
 };
 
+// The hits of a block of packet lanes (Shape::intersectLanes): bit i of `mask` set when lane i
+// hit, with its hit in hit[i].
+struct LaneHits {
+  uint32_t mask = 0;
+  LocalHit hit[RayLanes::kMaxLanes];
+};
+
 // A hit point rebuilt on the surface, with the bound of its rounding error (core/ray_spawn.h).
 struct SurfacePoint {
   Vec3 p;
@@ -61,6 +68,12 @@ class Shape {
   // decides each of them. Shapes with a SIMD filter (accel/shape_lanes.h) clear the bits of
   // lanes that certainly miss; the default keeps every live lane.
   virtual uint32_t candidateLanes(const RayLanes& rays) const;
+
+  // The closest hit of each live lane with t in (tnear, tfar), for Embree's callbacks: what a
+  // ray hits is always decided here, for single rays and packets alike. The default runs
+  // intersect() on the candidate lanes; flat shapes settle the rays that certainly hit inside
+  // their edges in their lane kernel and run intersect() on the rest.
+  virtual void intersectLanes(const RayLanes& rays, LaneHits& out) const;
 
   // The texture coordinates of a hit that intersect() reported. Shapes whose UV needs more than
   // the closest hit's parameters (the sphere's inverse trigonometry) compute it here, once for
@@ -110,10 +123,16 @@ struct DoublePlane {
   // Whether the ray meets the plane at a t in (tMin, tMax): a cheap first test for flat shapes,
   // which rejects the many shadow rays that end just short of an emitter on this plane.
   bool crossedWithin(const Ray& ray, float tMin, float tMax) const {
+    float t;
+    return crossedWithin(ray, tMin, tMax, t);
+  }
+  // The same, with the crossing's t (rounded to float) when it is within the interval.
+  bool crossedWithin(const Ray& ray, float tMin, float tMax, float& tHit) const {
     const glm::dvec3 dir(ray.dir);
     const double denom = glm::dot(n, dir);
     if (denom == 0.0) return false;
     const double t = (d - glm::dot(n, glm::dvec3(ray.origin))) / denom;
+    tHit = float(t);
     return t > double(tMin) && t < double(tMax);
   }
 };

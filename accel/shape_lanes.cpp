@@ -80,13 +80,18 @@ HWY_INLINE uint32_t forEachBlock(D d, const RayLanes& rays, Block block) {
   return bits & inRange;
 }
 
-uint32_t TriangleCandidates(const RayLanes& rays, const TriangleFilter& tri) {
+void TriangleLanesKernel(const RayLanes& rays, const TriangleFilter& tri, TriangleLanes& out) {
   const D d;
   const Vec3V n = splat(d, tri.n), v0 = splat(d, tri.v0), g1 = splat(d, tri.g1), g2 = splat(d, tri.g2);
   const V planeD = hn::Set(d, tri.d), dError = hn::Set(d, tri.dError);
   const V v0Max = hn::Set(d, tri.v0Max), g1Sum = hn::Set(d, tri.g1Sum), g2Sum = hn::Set(d, tri.g2Sum);
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0f);
-  return forEachBlock(d, rays, [&](const LaneBlock& b) {
+  const V baryTolerance = hn::Set(d, TriangleLanes::kBarycentricError);
+  const unsigned step = unsigned(hn::Lanes(d));
+  out.candidates = out.inside = 0;
+  for (unsigned i = 0; i < rays.n; i += step) {
+    const LaneBlock b = loadBlock(d, rays, i);
+    if (hn::AllFalse(d, b.live)) continue;
     // The plane: t = (d - n.o) / (n.dir). With num = num_f + a and den = den_f + b the exact t
     // differs from num_f / den_f by at most (|a| + |t| |b|) / (|den_f| - |b|), plus the division's
     // rounding.
@@ -124,8 +129,22 @@ uint32_t TriangleCandidates(const RayLanes& rays, const TriangleFilter& tri) {
             : hn::Gt(hn::Sub(hn::Add(b1, b2), hn::Add(hn::Add(b1Error, b2Error), hn::Set(d, gamma(2)))), one);
     const M outside = hn::Or(below, beyond);
     const M certainMiss = hn::Or(planeMiss, hn::And(hn::Gt(slack, zero), outside));
-    return hn::Not(certainMiss);
-  });
+    // Certainly inside: every edge test passes with its error bound, the mirror of `outside`.
+    const M above = hn::And(hn::Gt(hn::Sub(b1, b1Error), zero), hn::Gt(hn::Sub(b2, b2Error), zero));
+    const M within =
+        tri.parallelogram
+            ? hn::And(hn::Lt(hn::Add(b1, b1Error), one), hn::Lt(hn::Add(b2, b2Error), one))
+            : hn::Lt(hn::Add(hn::Add(b1, b2), hn::Add(hn::Add(b1Error, b2Error), hn::Set(d, gamma(2)))), one);
+    const M accurate = hn::Lt(hn::Add(b1Error, b2Error), baryTolerance);
+    const M inside = hn::And(hn::And(hn::Gt(slack, zero), accurate), hn::And(above, within));
+    hn::StoreU(b1, d, out.b1 + i);
+    hn::StoreU(b2, d, out.b2 + i);
+    out.candidates |= maskBits(d, hn::AndNot(certainMiss, b.live)) << i;
+    out.inside |= maskBits(d, hn::And(b.live, inside)) << i;
+  }
+  const uint32_t inRange = rays.n >= 32 ? ~0u : (1u << rays.n) - 1u;
+  out.candidates &= inRange;
+  out.inside &= out.candidates;
 }
 
 uint32_t SphereCandidates(const RayLanes& rays, const Vec3& center, float radius) {
@@ -169,7 +188,7 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 namespace ember {
 
-HWY_EXPORT(TriangleCandidates);
+HWY_EXPORT(TriangleLanesKernel);
 HWY_EXPORT(SphereCandidates);
 
 TriangleFilter TriangleFilter::of(const Vec3& v0, const Vec3& v1, const Vec3& v2, const DoublePlane& plane,
@@ -199,8 +218,8 @@ TriangleFilter TriangleFilter::of(const Vec3& v0, const Vec3& v1, const Vec3& v2
   return f;
 }
 
-uint32_t triangleCandidates(const RayLanes& rays, const TriangleFilter& tri) {
-  return HWY_DYNAMIC_DISPATCH(TriangleCandidates)(rays, tri);
+void triangleLanes(const RayLanes& rays, const TriangleFilter& tri, TriangleLanes& out) {
+  HWY_DYNAMIC_DISPATCH(TriangleLanesKernel)(rays, tri, out);
 }
 
 uint32_t sphereCandidates(const RayLanes& rays, const Vec3& center, float radius) {

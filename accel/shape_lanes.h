@@ -4,9 +4,13 @@
 // (Highway vectors, 16 floats per AVX-512 register; the widest ISA the CPU has is picked at run
 // time by HWY_DYNAMIC_DISPATCH) and carries a conservative bound on its rounding error, so it
 // rejects only rays that certainly miss. The few that may hit are then intersected by the shape's
-// scalar, double-precision routine. The filter decides nothing else, so a packet finds exactly
-// the hits single rays find, bit for bit (tests/test_shape_lanes.cpp), and the robustness of the
-// double-precision routines (no acne, no leaks at grazing angles) carries over unchanged.
+// scalar, double-precision routine. The flat shapes' kernel also says which rays certainly meet
+// the shape inside its edges, away from them by more than the rounding error; for those the hit is
+// settled without the exact routine (Shape::intersectLanes): its t comes from the shape's
+// double-precision plane, so it is as accurate as before. Single rays take the same route as
+// packets, so both find the same hits bit for bit, and the robustness of the double-precision
+// routines (no acne, no leaks at grazing angles) carries over to the rays near edges, where it
+// matters (tests/test_shape_lanes.cpp).
 //
 // Error bounds follow the standard model fl(a op b) = (a op b)(1 + d), |d| <= eps = 2^-24, and
 // gamma(n) = n eps / (1 - n eps) for sums and dot products of n terms (Higham 2002, ch. 3;
@@ -30,6 +34,10 @@ struct RayLanes {
   const float* tfar;
   const int* valid;  // -1 = live
   unsigned n;
+
+  Ray ray(unsigned i) const {
+    return Ray{Vec3(org[0][i], org[1][i], org[2][i]), Vec3(dir[0][i], dir[1][i], dir[2][i]), tfar[i]};
+  }
 };
 
 // A triangle (v0, v1, v2) as its float filter sees it: the plane dot(n, x) = d, and the dual
@@ -51,9 +59,23 @@ struct TriangleFilter {
                            bool parallelogram = false);
 };
 
-// Bit i set: live lane i may hit the triangle (DoublePlane::crossedWithin and intersectTriangle
-// might both succeed); clear: it certainly misses.
-uint32_t triangleCandidates(const RayLanes& rays, const TriangleFilter& tri);
+// What the triangle kernel found for a block of rays.
+struct TriangleLanes {
+  // Bit i set: live lane i may hit the triangle (DoublePlane::crossedWithin and intersectTriangle
+  // might both succeed); clear: it certainly misses.
+  uint32_t candidates = 0;
+  // Bit i set: lane i meets the triangle's plane certainly inside the triangle (or parallelogram),
+  // whatever its t, and its barycentrics b1, b2 are within kBarycentricError of the exact ones.
+  uint32_t inside = 0;
+  alignas(64) float b1[RayLanes::kMaxLanes];
+  alignas(64) float b2[RayLanes::kMaxLanes];
+
+  // Barycentrics this close are as good as the exact ones for texture lookups: 1/16 of a texel
+  // of a 4096-texel texture.
+  static constexpr float kBarycentricError = 0x1p-16f;
+};
+
+void triangleLanes(const RayLanes& rays, const TriangleFilter& tri, TriangleLanes& out);
 
 // Bit i set: live lane i may hit the sphere (its discriminant may be >= 0).
 uint32_t sphereCandidates(const RayLanes& rays, const Vec3& center, float radius);

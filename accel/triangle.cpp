@@ -61,6 +61,32 @@ bool Triangle::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) 
   return true;
 }
 
+uint32_t Triangle::candidateLanes(const RayLanes& rays) const {
+  TriangleLanes lanes;
+  triangleLanes(rays, filter_, lanes);
+  return lanes.candidates;
+}
+
+void Triangle::intersectLanes(const RayLanes& rays, LaneHits& out) const {
+  TriangleLanes lanes;
+  triangleLanes(rays, filter_, lanes);
+  out.mask = 0;
+  for (uint32_t bits = lanes.candidates; bits != 0; bits &= bits - 1) {
+    const unsigned i = unsigned(__builtin_ctz(bits));
+    const Ray ray = rays.ray(i);
+    LocalHit& h = out.hit[i];
+    bool hit;
+    if ((lanes.inside >> i) & 1u) {
+      hit = plane_.crossedWithin(ray, rays.tnear[i], ray.tMax, h.t);
+      h.ng = normal_;
+      h.uv = (1.0f - lanes.b1[i] - lanes.b2[i]) * uv_[0] + lanes.b1[i] * uv_[1] + lanes.b2[i] * uv_[2];
+    } else {
+      hit = intersect(ray, rays.tnear[i], ray.tMax, h);
+    }
+    if (hit) out.mask |= 1u << i;
+  }
+}
+
 bool Triangle::sampleSolidAngle(const Vec3& ref, Vec2 u, ShapeSample& s, float& pdf) const {
   if (const auto st = sphericalTriangleForSampling(ref, v_[0], v_[1], v_[2], area_)) {
     const Vec2 b = barycentricsAlong(v_[0], v_[1], v_[2], ref, st->sample(u));
@@ -136,20 +162,76 @@ Bounds Quad::bounds() const {
   return b;
 }
 
-bool Quad::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const {
+bool Quad::intersectHalf(int half, const Ray& ray, float tMin, float tMax, LocalHit& hit) const {
+  const Vec3& a = v_[half == 0 ? 1 : 2];
+  const Vec3& b = v_[half == 0 ? 2 : 3];
   float t, b1, b2;
-  if (planes_[0].crossedWithin(ray, tMin, tMax) &&
-      intersectTriangle(ray, v_[0], v_[1], v_[2], tMin, tMax, t, b1, b2)) {
-    hit.uv = (1.0f - b1 - b2) * uv_[0] + b1 * uv_[1] + b2 * uv_[2];
-  } else if (planes_[1].crossedWithin(ray, tMin, tMax) &&
-             intersectTriangle(ray, v_[0], v_[2], v_[3], tMin, tMax, t, b1, b2)) {
-    hit.uv = (1.0f - b1 - b2) * uv_[0] + b1 * uv_[2] + b2 * uv_[3];
-  } else {
+  if (!planes_[half].crossedWithin(ray, tMin, tMax) ||
+      !intersectTriangle(ray, v_[0], a, b, tMin, tMax, t, b1, b2))
     return false;
-  }
   hit.t = t;
   hit.ng = normal_;
+  hit.uv = (1.0f - b1 - b2) * uv_[0] + b1 * uv_[half == 0 ? 1 : 2] + b2 * uv_[half == 0 ? 2 : 3];
   return true;
+}
+
+bool Quad::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const {
+  return intersectHalf(0, ray, tMin, tMax, hit) || intersectHalf(1, ray, tMin, tMax, hit);
+}
+
+bool Quad::settledHit(int half, const Ray& ray, float tMin, float tMax, float b1, float b2,
+                      LocalHit& hit) const {
+  if (!planes_[half].crossedWithin(ray, tMin, tMax, hit.t)) return false;
+  hit.ng = normal_;
+  hit.uv = (1.0f - b1 - b2) * uv_[0] + b1 * uv_[half == 0 ? 1 : 2] + b2 * uv_[half == 0 ? 2 : 3];
+  return true;
+}
+
+uint32_t Quad::candidateLanes(const RayLanes& rays) const {
+  TriangleLanes lanes;
+  triangleLanes(rays, filters_[0], lanes);
+  if (singleFilter_) return lanes.candidates;
+  const uint32_t first = lanes.candidates;
+  triangleLanes(rays, filters_[1], lanes);
+  return first | lanes.candidates;
+}
+
+// Each half is settled by its kernel where the kernel is certain, and tested exactly where not;
+// as in intersect(), the first half wins when both are hit.
+void Quad::intersectLanes(const RayLanes& rays, LaneHits& out) const {
+  out.mask = 0;
+  TriangleLanes first;
+  triangleLanes(rays, filters_[0], first);
+  if (singleFilter_) {
+    // (s, r) = (b1, b2) are the parallelogram's coordinates along v1 - v0 and v3 - v0. The half
+    // (v0, v1, v2) is s >= r, with barycentrics (s - r, r); the other has (s, r - s).
+    for (uint32_t bits = first.candidates; bits != 0; bits &= bits - 1) {
+      const unsigned i = unsigned(__builtin_ctz(bits));
+      const Ray ray = rays.ray(i);
+      const float tMin = rays.tnear[i], s = first.b1[i], r = first.b2[i];
+      LocalHit& h = out.hit[i];
+      const bool hit = ((first.inside >> i) & 1u) ? (s >= r ? settledHit(0, ray, tMin, ray.tMax, s - r, r, h)
+                                                            : settledHit(1, ray, tMin, ray.tMax, s, r - s, h))
+                                                  : intersect(ray, tMin, ray.tMax, h);
+      if (hit) out.mask |= 1u << i;
+    }
+    return;
+  }
+  TriangleLanes second;
+  triangleLanes(rays, filters_[1], second);
+  for (uint32_t bits = first.candidates | second.candidates; bits != 0; bits &= bits - 1) {
+    const unsigned i = unsigned(__builtin_ctz(bits));
+    const uint32_t bit = 1u << i;
+    const Ray ray = rays.ray(i);
+    const float tMin = rays.tnear[i];
+    LocalHit& h = out.hit[i];
+    auto half = [&](int k, const TriangleLanes& lanes) {
+      if (!(lanes.candidates & bit)) return false;
+      if (lanes.inside & bit) return settledHit(k, ray, tMin, ray.tMax, lanes.b1[i], lanes.b2[i], h);
+      return intersectHalf(k, ray, tMin, ray.tMax, h);
+    };
+    if (half(0, first) || half(1, second)) out.mask |= bit;
+  }
 }
 
 SurfacePoint Quad::projectToSurface(const Vec3& p, const LocalHit&) const {

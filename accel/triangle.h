@@ -24,7 +24,8 @@ class Triangle final : public Shape {
   std::string_view typeName() const override { return "triangle"; }
   Bounds bounds() const override;
   bool intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const override;
-  uint32_t candidateLanes(const RayLanes& rays) const override { return triangleCandidates(rays, filter_); }
+  uint32_t candidateLanes(const RayLanes& rays) const override;
+  void intersectLanes(const RayLanes& rays, LaneHits& out) const override;
   SurfacePoint projectToSurface(const Vec3& p, const LocalHit&) const override { return plane_.project(p); }
   float area() const override { return area_; }
   ShapeSample sampleArea(Vec2 u) const override;
@@ -48,10 +49,8 @@ class Quad final : public Shape {
   std::string_view typeName() const override { return "quad"; }
   Bounds bounds() const override;
   bool intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const override;
-  uint32_t candidateLanes(const RayLanes& rays) const override {
-    const uint32_t first = triangleCandidates(rays, filters_[0]);
-    return singleFilter_ ? first : first | triangleCandidates(rays, filters_[1]);
-  }
+  uint32_t candidateLanes(const RayLanes& rays) const override;
+  void intersectLanes(const RayLanes& rays, LaneHits& out) const override;
   // Onto the plane of the half (v0, v1, v2) or (v0, v2, v3) that p lies over: a quad's four
   // vertices need only be coplanar to 1e-4 of its size.
   SurfacePoint projectToSurface(const Vec3& p, const LocalHit& hit) const override;
@@ -63,6 +62,12 @@ class Quad final : public Shape {
   bool isRectangle() const { return rectangle_; }
 
  private:
+  // The exact test of one half, (v0, v1, v2) or (v0, v2, v3).
+  bool intersectHalf(int half, const Ray& ray, float tMin, float tMax, LocalHit& hit) const;
+  // A hit settled by the lane kernel: t where the ray crosses the half's plane, if within the
+  // interval, and the uv of the half's barycentrics (b1, b2) of its second and third vertex.
+  bool settledHit(int half, const Ray& ray, float tMin, float tMax, float b1, float b2, LocalHit& hit) const;
+
   bool rectangle_;
   std::array<Vec3, 4> v_;
   std::array<Vec2, 4> uv_;

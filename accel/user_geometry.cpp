@@ -59,14 +59,6 @@ class PacketLanes {
                     pad_.valid,
                     count};
   }
-  Ray ray(unsigned i) const {
-    Ray r;
-    r.origin = Vec3(f_[i], f_[n_ + i], f_[2 * n_ + i]);
-    r.dir = Vec3(f_[4 * n_ + i], f_[5 * n_ + i], f_[6 * n_ + i]);
-    r.tMax = f_[8 * n_ + i];
-    return r;
-  }
-  float tnear(unsigned i) const { return f_[3 * n_ + i]; }
 
  private:
   struct Padded {
@@ -82,24 +74,18 @@ class PacketLanes {
   Padded pad_;
 };
 
-// Calls report(lane, hit) for each live lane of the packet that hits the shape. The shape's lane
-// filter (accel/shape_lanes.h) drops the lanes that certainly miss; the scalar routine decides
-// the rest, so a packet finds the hits single rays find. Single rays go straight to it.
+// Calls report(lane, hit) for each live lane of the packet that hits the shape, as the shape's
+// intersectLanes decides it. Single rays take the same route (a padded block of one live lane),
+// so a packet finds exactly the hits single rays find.
 template <typename Report>
 void intersectPacket(const Shape& shape, RTCRayN* rays, unsigned n, const int* valid, Report report) {
   PacketLanes packet(rays, n, valid);
-  if (n == 1) {
-    LocalHit h;
-    if (valid[0] == -1 && shape.intersect(packet.ray(0), packet.tnear(0), packet.ray(0).tMax, h))
-      report(0u, h);
-    return;
-  }
+  LaneHits hits;
   for (unsigned k = 0; k < packet.blocks(); ++k) {
-    for (uint32_t bits = shape.candidateLanes(packet.block(k)); bits != 0; bits &= bits - 1) {
-      const unsigned i = k * RayLanes::kMaxLanes + unsigned(__builtin_ctz(bits));
-      const Ray ray = packet.ray(i);
-      LocalHit h;
-      if (shape.intersect(ray, packet.tnear(i), ray.tMax, h)) report(i, h);
+    shape.intersectLanes(packet.block(k), hits);
+    for (uint32_t bits = hits.mask; bits != 0; bits &= bits - 1) {
+      const unsigned lane = unsigned(__builtin_ctz(bits));
+      report(k * RayLanes::kMaxLanes + lane, hits.hit[lane]);
     }
   }
 }

@@ -62,7 +62,28 @@ struct Tally {
   int rejected = 0;  // ... of them rejected by the filter
   int deadKept = 0;  // dead lanes reported as candidates: must stay 0
   std::string example;
+  // Shape::intersectLanes, the route every ray takes, against intersect() lane by lane.
+  int laneDisagrees = 0;  // hit in one, miss in the other: must stay 0
+  int laneInexact = 0;    // both hit, but t, normal or uv differ beyond rounding: must stay 0
+  int deadHit = 0;        // dead lanes reported as hits: must stay 0
+  std::string laneExample;
 };
+
+std::string describe(const Ray& r) {
+  char buf[200];
+  std::snprintf(buf, sizeof buf, "o (%.9g %.9g %.9g) d (%.9g %.9g %.9g) tMax %.9g", r.origin.x, r.origin.y,
+                r.origin.z, r.dir.x, r.dir.y, r.dir.z, r.tMax);
+  return buf;
+}
+
+// Both are the exact hit rounded to float, computed by different double-precision formulas (the
+// plane's crossing against Moller-Trumbore), so t may differ by an ulp; the kernel's float
+// barycentrics are within TriangleLanes::kBarycentricError.
+bool sameHit(const LocalHit& a, const LocalHit& b) {
+  const bool t = std::abs(a.t - b.t) <= 2.5e-7f * std::abs(b.t);
+  const bool uv = glm::length(a.uv - b.uv) <= 4.0f * TriangleLanes::kBarycentricError;
+  return t && uv && a.ng == b.ng;
+}
 
 using RayMaker = std::function<Ray(Rng&)>;
 
@@ -76,14 +97,30 @@ void check(const Shape& shape, const RayMaker& make, int blocks, uint64_t seed, 
       block.set(i, rays[i], rng.uniform() < 0.85f);
     }
     const uint32_t bits = shape.candidateLanes(block.lanes());
+    LaneHits laneHits;
+    shape.intersectLanes(block.lanes(), laneHits);
     for (unsigned i = 0; i < RayLanes::kMaxLanes; ++i) {
       const bool kept = (bits >> i) & 1u;
+      const bool laneHit = (laneHits.mask >> i) & 1u;
       if (block.valid[i] != -1) {
         t.deadKept += kept;
+        t.deadHit += laneHit;
         continue;
       }
       LocalHit h;
-      if (shape.intersect(rays[i], 0.0f, rays[i].tMax, h)) {
+      const bool hit = shape.intersect(rays[i], 0.0f, rays[i].tMax, h);
+      if (laneHit != hit || (hit && !sameHit(laneHits.hit[i], h))) {
+        ++(laneHit != hit ? t.laneDisagrees : t.laneInexact);
+        if (t.laneExample.empty()) {
+          char buf[160];
+          std::snprintf(buf, sizeof buf,
+                        ": lanes %s t %.9g uv (%.7g %.7g), intersect() %s t %.9g uv (%.7g %.7g)",
+                        laneHit ? "hit" : "miss", laneHits.hit[i].t, laneHits.hit[i].uv.x,
+                        laneHits.hit[i].uv.y, hit ? "hit" : "miss", h.t, h.uv.x, h.uv.y);
+          t.laneExample = describe(rays[i]) + buf;
+        }
+      }
+      if (hit) {
         ++t.hits;
         if (!kept && t.missed++ == 0) {
           char buf[256];
@@ -214,6 +251,9 @@ void runAll(const Vec3& at, float size, uint64_t seed) {
       EXPECT_EQ(t.missed, 0) << "the filter rejected " << t.missed << " of " << t.hits
                              << " lanes the scalar routine hits; first: " << t.example;
       EXPECT_EQ(t.deadKept, 0);
+      EXPECT_EQ(t.deadHit, 0);
+      EXPECT_EQ(t.laneDisagrees, 0) << "first: " << t.laneExample;
+      EXPECT_EQ(t.laneInexact, 0) << "first: " << t.laneExample;
       if (family != "random") continue;
       if (c.hasFilter) {
         EXPECT_GT(t.rejected, t.misses * 9 / 10) << "rejects too few of " << t.misses << " misses";
