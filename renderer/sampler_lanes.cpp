@@ -12,63 +12,52 @@ HWY_BEFORE_NAMESPACE();
 namespace ember::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-// 32-bit arithmetic in 64-bit lanes: the products of Burley's hash need the low 32 bits of 32 x
-// 32-bit multiplies, which 64-bit lanes hold exactly, and mix64 needs 64-bit lanes anyway.
-using D = hn::CappedTag<uint64_t, SobolBlock::kBlock>;  // never wider than a block
+// The hashes are 32-bit integer arithmetic (wrapping multiplies), 16 lanes per AVX-512 vector.
+// The dimension seeds' 64-bit mix64 is done while the block is gathered, once per request.
+using D = hn::CappedTag<uint32_t, SobolBlock::kBlock>;  // never wider than a block
 using V = hn::Vec<D>;
 
-HWY_INLINE V low32(D d, V x) {
-  return hn::And(x, hn::Set(d, 0xffffffffull));
-}
-HWY_INLINE V mulLow32(D d, V x, uint32_t c) {
-  return low32(d, hn::Mul(x, hn::Set(d, uint64_t(c))));
-}
-// SplitMix64's finaliser (core/rng.h, mix64).
-HWY_INLINE V mix64(D d, V x) {
-  x = hn::Add(x, hn::Set(d, 0x9e3779b97f4a7c15ull));
-  x = hn::Mul(hn::Xor(x, hn::ShiftRight<30>(x)), hn::Set(d, 0xbf58476d1ce4e5b9ull));
-  x = hn::Mul(hn::Xor(x, hn::ShiftRight<27>(x)), hn::Set(d, 0x94d049bb133111ebull));
-  return hn::Xor(x, hn::ShiftRight<31>(x));
+HWY_INLINE V mulBy(D d, V x, uint32_t c) {
+  return hn::Mul(x, hn::Set(d, c));
 }
 HWY_INLINE V reverseBits32(D d, V x) {
-  x = low32(d, hn::Or(hn::ShiftRight<16>(x), hn::ShiftLeft<16>(x)));
-  auto swap = [&](V v, int shift, uint64_t mask) {
+  x = hn::Or(hn::ShiftRight<16>(x), hn::ShiftLeft<16>(x));
+  auto swap = [&](V v, int shift, uint32_t mask) {
     const V m = hn::Set(d, mask);
     return hn::Or(hn::And(hn::ShiftRightSame(v, shift), m), hn::ShiftLeftSame(hn::And(v, m), shift));
   };
-  x = swap(x, 8, 0x00ff00ffull);
-  x = swap(x, 4, 0x0f0f0f0full);
-  x = swap(x, 2, 0x33333333ull);
-  return swap(x, 1, 0x55555555ull);
+  x = swap(x, 8, 0x00ff00ffu);
+  x = swap(x, 4, 0x0f0f0f0fu);
+  x = swap(x, 2, 0x33333333u);
+  return swap(x, 1, 0x55555555u);
 }
 // Burley 2020, listing 2 (renderer/sampler.h, laineKarras).
 HWY_INLINE V laineKarras(D d, V x, V seed) {
-  x = low32(d, hn::Add(x, seed));
-  x = hn::Xor(x, mulLow32(d, x, 0x6c50b47cu));
-  x = hn::Xor(x, mulLow32(d, x, 0xb82f1e52u));
-  x = hn::Xor(x, mulLow32(d, x, 0xc7afe638u));
-  return hn::Xor(x, mulLow32(d, x, 0x8d22f6e6u));
+  x = hn::Add(x, seed);
+  x = hn::Xor(x, mulBy(d, x, 0x6c50b47cu));
+  x = hn::Xor(x, mulBy(d, x, 0xb82f1e52u));
+  x = hn::Xor(x, mulBy(d, x, 0xc7afe638u));
+  return hn::Xor(x, mulBy(d, x, 0x8d22f6e6u));
 }
 // The second Sobol dimension, bit-reversed (renderer/sampler.h, sobolSecondReversed).
 HWY_INLINE V sobolSecondReversed(D d, V i) {
-  i = hn::Xor(i, hn::And(hn::ShiftRight<1>(i), hn::Set(d, 0x55555555ull)));
-  i = hn::Xor(i, hn::And(hn::ShiftRight<2>(i), hn::Set(d, 0x33333333ull)));
-  i = hn::Xor(i, hn::And(hn::ShiftRight<4>(i), hn::Set(d, 0x0f0f0f0full)));
-  i = hn::Xor(i, hn::And(hn::ShiftRight<8>(i), hn::Set(d, 0x00ff00ffull)));
-  return hn::Xor(i, hn::And(hn::ShiftRight<16>(i), hn::Set(d, 0x0000ffffull)));
+  i = hn::Xor(i, hn::And(hn::ShiftRight<1>(i), hn::Set(d, 0x55555555u)));
+  i = hn::Xor(i, hn::And(hn::ShiftRight<2>(i), hn::Set(d, 0x33333333u)));
+  i = hn::Xor(i, hn::And(hn::ShiftRight<4>(i), hn::Set(d, 0x0f0f0f0fu)));
+  i = hn::Xor(i, hn::And(hn::ShiftRight<8>(i), hn::Set(d, 0x00ff00ffu)));
+  return hn::Xor(i, hn::And(hn::ShiftRight<16>(i), hn::Set(d, 0x0000ffffu)));
 }
 
 void SobolLanes(SobolBlock& b, size_t n, bool twoD) {
   const D d;
   for (size_t i = 0; i < n; i += hn::Lanes(d)) {
-    const V seed = low32(d, mix64(d, hn::LoadU(d, b.seedKey + i)));
+    const V seed = hn::LoadU(d, b.seed + i);
     // Owen-scrambled index: a per-dimension shuffle of the pixel's sample order.
     const V index = hn::LoadU(d, b.index + i);
-    const V shuffled =
-        reverseBits32(d, laineKarras(d, reverseBits32(d, index), mulLow32(d, seed, 0xc2b2ae35u)));
-    hn::StoreU(reverseBits32(d, laineKarras(d, shuffled, mulLow32(d, seed, 0x9e3779b9u))), d, b.first + i);
+    const V shuffled = reverseBits32(d, laineKarras(d, reverseBits32(d, index), mulBy(d, seed, 0xc2b2ae35u)));
+    hn::StoreU(reverseBits32(d, laineKarras(d, shuffled, mulBy(d, seed, 0x9e3779b9u))), d, b.first + i);
     if (twoD) {
-      const V second = laineKarras(d, sobolSecondReversed(d, shuffled), mulLow32(d, seed, 0x85ebca6bu));
+      const V second = laineKarras(d, sobolSecondReversed(d, shuffled), mulBy(d, seed, 0x85ebca6bu));
       hn::StoreU(reverseBits32(d, second), d, b.second + i);
     }
   }
@@ -84,8 +73,8 @@ HWY_EXPORT(SobolLanes);
 
 namespace {
 
-float toFloat(uint64_t x) {
-  return float(uint32_t(x) >> 8) * 0x1p-24f;
+float toFloat(uint32_t x) {
+  return float(x >> 8) * 0x1p-24f;
 }
 
 // Draws a request for every sampler: the Sobol ones in blocks through the kernel, the others
@@ -97,8 +86,8 @@ void drawLanes(Sampler* const* samplers, size_t n, Store store, Scalar scalar) {
   size_t count = 0;
   auto flush = [&] {
     // Lanes past `count` are hashed too (vectors are whole); their inputs are kept defined.
-    std::fill(block.seedKey + count, block.seedKey + SobolBlock::kBlock, 0);
-    std::fill(block.index + count, block.index + SobolBlock::kBlock, 0);
+    std::fill(block.seed + count, block.seed + SobolBlock::kBlock, 0u);
+    std::fill(block.index + count, block.index + SobolBlock::kBlock, 0u);
     HWY_DYNAMIC_DISPATCH(SobolLanes)(block, SobolBlock::kBlock, kTwoD);
     for (size_t k = 0; k < count; ++k)
       store(lane[k], toFloat(block.first[k]), kTwoD ? toFloat(block.second[k]) : 0.0f);
@@ -110,7 +99,7 @@ void drawLanes(Sampler* const* samplers, size_t n, Store store, Scalar scalar) {
       scalar(i, s);
       continue;
     }
-    block.seedKey[count] = (uint64_t(s.pixelSeed()) << 32) | s.dimension();
+    block.seed[count] = uint32_t(mix64((uint64_t(s.pixelSeed()) << 32) | s.dimension()));
     block.index[count] = s.sampleIndex();
     lane[count++] = i;
     s.skipDimension();

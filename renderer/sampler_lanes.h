@@ -1,7 +1,7 @@
 // The Sobol sampler's requests for many samplers at once (a bounce of a wave,
 // packet/wavefront_integrator.cpp): each sampler's next 1D or 2D request, exactly the value its
 // get1D / get2D would return. The Owen-scrambling hashes (renderer/sampler.h) are integer
-// arithmetic, so the Highway kernel (64-bit lanes, the widest ISA the CPU has) equals the scalar
+// arithmetic, so the Highway kernel (32-bit lanes, the widest ISA the CPU has) equals the scalar
 // code bit for bit by construction (tests/test_sampling_lanes.cpp); requests past the Sobol
 // dimensions, and the independent sampler's, come from each sampler's own PCG32 stream.
 #pragma once
@@ -17,10 +17,10 @@ namespace ember {
 // their 32-bit results before the conversion to float.
 struct SobolBlock {
   static constexpr size_t kBlock = 16;
-  alignas(64) uint64_t seedKey[kBlock];  // pixelSeed << 32 | dimension, hashed by mix64
-  alignas(64) uint64_t index[kBlock];
-  alignas(64) uint64_t first[kBlock];
-  alignas(64) uint64_t second[kBlock];
+  alignas(64) uint32_t seed[kBlock];  // the dimension's seed, mix64(pixelSeed << 32 | dimension)
+  alignas(64) uint32_t index[kBlock];
+  alignas(64) uint32_t first[kBlock];
+  alignas(64) uint32_t second[kBlock];
 };
 
 // out[i] = samplers[i]->get1D() for i < n.
