@@ -15,7 +15,7 @@ struct SurfaceHit {
   Vec3 p;
   Vec3 ng;  // unit geometric normal: outward for closed shapes, the front side otherwise
   Vec3 ns;  // unit shading normal, in the same hemisphere as ng
-  Vec2 uv;
+  Vec2 uv;  // texture coordinates; (0, 0) on an analytic shape whose material reads none
   float t = 0.0f;
   float pError = roundingErrorBound(0.0f);  // rounding-error bound of p (core/ray_spawn.h)
   const Material* material = nullptr;

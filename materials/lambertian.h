@@ -21,6 +21,7 @@ class Lambertian final : public Material {
   void sampleLanes(const SurfaceHit* const* hits, const Vec3* wo, const Vec2* u, const float* uLobe, size_t n,
                    BsdfSample* out, bool* ok) const override;
   bool hasNonDeltaLobes() const override { return !isBlack(reflectance_->maxValue()); }
+  bool readsUv() const override { return !reflectance_->isConstant(); }
 
  private:
   // The sample from the kernel's direction and pdf.

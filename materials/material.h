@@ -45,6 +45,10 @@ class Material {
   // Whether eval can be non-zero, i.e. light sampling is worth a shadow ray.
   virtual bool hasNonDeltaLobes() const { return true; }
 
+  // Whether any of its parameters is a texture, i.e. its hits need texture coordinates. Hits on
+  // analytic shapes skip the UV (the sphere's inverse trigonometry) when the material reads none.
+  virtual bool readsUv() const { return true; }
+
   // Fraction of radiance surviving `distance` through the medium this surface encloses (Beer-Lambert;
   // 1 for surfaces without an absorbing interior). Applied to path segments that reach the surface
   // from inside, i.e. against its outward geometric normal: correct for closed, non-nested objects.

@@ -23,6 +23,7 @@ class Mirror final : public Material {
   float pdf(const SurfaceHit&, const Vec3&, const Vec3&) const override { return 0.0f; }
   bool sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float uLobe, BsdfSample& out) const override;
   bool hasNonDeltaLobes() const override { return false; }
+  bool readsUv() const override { return false; }
 
  private:
   Color reflectance_;
@@ -37,6 +38,7 @@ class Refraction final : public Material {
   float pdf(const SurfaceHit&, const Vec3&, const Vec3&) const override { return 0.0f; }
   bool sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float uLobe, BsdfSample& out) const override;
   bool hasNonDeltaLobes() const override { return false; }
+  bool readsUv() const override { return false; }
 
  private:
   Color transmittance_;
@@ -51,6 +53,7 @@ class Dielectric final : public Material {
   float pdf(const SurfaceHit&, const Vec3&, const Vec3&) const override { return 0.0f; }
   bool sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float uLobe, BsdfSample& out) const override;
   bool hasNonDeltaLobes() const override { return false; }
+  bool readsUv() const override { return false; }
 
  private:
   float iorInside_, iorOutside_;

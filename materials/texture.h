@@ -19,6 +19,8 @@ class Texture {
   virtual Color maxValue() const = 0;
   // Mean over the texture's area.
   virtual Color average() const = 0;
+  // The same value at every uv.
+  virtual bool isConstant() const { return false; }
 };
 
 class ConstantTexture final : public Texture {
@@ -27,6 +29,7 @@ class ConstantTexture final : public Texture {
   Color eval(Vec2) const override { return value_; }
   Color maxValue() const override { return value_; }
   Color average() const override { return value_; }
+  bool isConstant() const override { return true; }
 
  private:
   Color value_;

@@ -23,6 +23,7 @@ void Scene::build() {
     const uint32_t id = accel_->addShape(entry.shape.get());
     GeometryRecord rec{entry.shape.get(), nullptr,        entry.material,
                        nullptr,           entry.emission, entry.twoSidedEmission};
+    rec.readsUv = !entry.material || entry.material->readsUv();
     if (!isBlack(entry.emission)) {
       lights.push_back(
           std::make_unique<AreaLight>(entry.shape.get(), entry.emission, entry.twoSidedEmission));
@@ -92,7 +93,7 @@ void Scene::surfaceHit(const Ray& ray, const RawHit& raw, SurfaceHit& hit) const
   if (rec.shape) {
     hit.ng = raw.ng;
     const LocalHit local{raw.t, raw.ng, raw.uv};
-    hit.uv = rec.shape->surfaceUv(local);
+    hit.uv = rec.readsUv ? rec.shape->surfaceUv(local) : Vec2(0.0f);
     const float magnitude = maxComponent(glm::abs(hit.p));
     if (raw.t > magnitude) {
       const SurfacePoint onSurface = rec.shape->projectToSurface(hit.p, local);

@@ -95,6 +95,7 @@ class Scene {
     bool twoSidedEmission = false;
     const SurfaceMaps* maps = nullptr;
     int64_t firstTriangleLight = -1;  // emissive meshes: index of primitive 0's light in triangleLights_
+    bool readsUv = true;              // whether the material reads the hit's texture coordinates
   };
 
   std::unique_ptr<EmbreeAccel> accel_;

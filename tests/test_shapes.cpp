@@ -19,13 +19,13 @@
 #include "accel/disc.h"
 #include "accel/sphere.h"
 #include "accel/triangle.h"
+#include "core/rng.h"
+#include "core/sampling.h"
+#include "core/surface_hit.h"
 #include "materials/fresnel.h"
 #include "materials/lambertian.h"
 #include "materials/texture.h"
-#include "core/rng.h"
-#include "core/sampling.h"
 #include "renderer/scene.h"
-#include "core/surface_hit.h"
 
 #include <gtest/gtest.h>
 
@@ -964,6 +964,50 @@ TEST(SpawnEmbree, NoAcneNoLeaksFarFromOrigin) {
 TEST(SpawnEmbree, NoAcneNoLeaksForHitsSeenFromAfar) {
   runSpawnTest(Vec3(0.0f), 303, 300.0f);
   runSpawnTest(Vec3(60.0f, -35.0f, 110.0f), 404, 300.0f);
+}
+
+}  // namespace
+}  // namespace ember
+
+namespace ember {
+namespace {
+
+// A hit on an analytic shape carries the shape's UV when its material reads textures, and skips
+// the UV (the sphere's inverse trigonometry) when it does not.
+TEST(SurfaceHitUv, ComputedOnlyForMaterialsThatReadTextures) {
+  auto image = std::make_shared<ImageTexture>(2, 2, std::vector<Color>(4, Color(0.5f)),
+                                              TextureFilter::Nearest, TextureWrap::Repeat);
+  auto constant = std::make_shared<ConstantTexture>(Color(0.5f));
+  EXPECT_TRUE(Lambertian(image).readsUv());
+  EXPECT_FALSE(Lambertian(constant).readsUv());
+
+  Scene scene;
+  const Material* textured = scene.addMaterial("textured", std::make_unique<Lambertian>(image));
+  const Material* plain = scene.addMaterial("plain", std::make_unique<Lambertian>(constant));
+  scene.shapes.push_back(
+      Scene::ShapeEntry{"textured", std::make_unique<Sphere>(Vec3(-2, 0, 0), 1.0f), textured, Color(0.0f)});
+  scene.shapes.push_back(
+      Scene::ShapeEntry{"plain", std::make_unique<Sphere>(Vec3(2, 0, 0), 1.0f), plain, Color(0.0f)});
+  scene.build();
+
+  const Vec3 dir = glm::normalize(Vec3(0.05f, -0.06f, -1.0f));
+  for (const float x : {-2.0f, 2.0f}) {
+    const Ray ray{Vec3(x, 0.4f, 5.0f), dir};
+    SurfaceHit h;
+    ASSERT_TRUE(scene.intersect(ray, h));
+    LocalHit local;
+    ASSERT_TRUE(scene.shapes[x < 0.0f ? 0 : 1].shape->intersect(ray, 0.0f, kInfinity, local));
+    const Vec2 uv = scene.shapes[x < 0.0f ? 0 : 1].shape->surfaceUv(local);
+    if (x < 0.0f) {
+      EXPECT_EQ(h.material, textured);
+      EXPECT_NEAR(h.uv.x, uv.x, 1e-5f);
+      EXPECT_NEAR(h.uv.y, uv.y, 1e-5f);
+      EXPECT_GT(h.uv.x, 0.0f);
+    } else {
+      EXPECT_EQ(h.material, plain);
+      EXPECT_EQ(h.uv, Vec2(0.0f));
+    }
+  }
 }
 
 }  // namespace
