@@ -87,7 +87,9 @@ void groupByGeometry(Wave& wave, size_t active, size_t geometries) {
 
 // Samples every query's light, one Light::sampleLanes call per run of queries of the same light.
 void sampleLights(Wave& wave, size_t queries) {
-  std::sort(wave.queryKey.begin(), wave.queryKey.begin() + ptrdiff_t(queries));
+  // Queries are made in vertex order, so with one light (or lights met in order) they are sorted.
+  const auto keys = wave.queryKey.begin(), keysEnd = keys + ptrdiff_t(queries);
+  if (!std::is_sorted(keys, keysEnd)) std::sort(keys, keysEnd);
   for (size_t q = 0; q < queries; ++q) {
     const size_t v = wave.queryKey[q] & 0xffffu;
     wave.queryOf[v] = int16_t(q);
