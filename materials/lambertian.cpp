@@ -19,6 +19,17 @@ float Lambertian::pdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) con
   return cosineHemispherePdf(glm::dot(wi, facingNormal(hit, wo)));
 }
 
+Color Lambertian::evalPdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi, float& pdfOut) const {
+  if (!sameSide(hit, wo, wi)) {
+    pdfOut = 0.0f;
+    return Color(0.0f);
+  }
+  const float cosI = glm::dot(wi, facingNormal(hit, wo));
+  pdfOut = cosineHemispherePdf(cosI);
+  if (cosI <= 0.0f) return Color(0.0f);
+  return reflectance_->eval(hit.uv) * (cosI * kInvPi);
+}
+
 // One live lane of the kernel, so that one vertex and a wave of them get the same direction.
 bool Lambertian::sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float, BsdfSample& out) const {
   CosineLanes lanes;

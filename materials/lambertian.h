@@ -11,16 +11,19 @@ namespace ember {
 
 class Lambertian final : public Material {
  public:
-  explicit Lambertian(std::shared_ptr<const Texture> reflectance) : reflectance_(std::move(reflectance)) {}
+  explicit Lambertian(std::shared_ptr<const Texture> reflectance)
+      : reflectance_(std::move(reflectance)), reflects_(!isBlack(reflectance_->maxValue())) {}
 
   std::string_view typeName() const override { return "diffuse"; }
   Color eval(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const override;
   float pdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const override;
+  // eval and pdf share the side test and the cosine.
+  Color evalPdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi, float& pdfOut) const override;
   bool sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float uLobe, BsdfSample& out) const override;
   // Blocks of sampleCosineLanes.
   void sampleLanes(const SurfaceHit* const* hits, const Vec3* wo, const Vec2* u, const float* uLobe, size_t n,
                    BsdfSample* out, bool* ok) const override;
-  bool hasNonDeltaLobes() const override { return !isBlack(reflectance_->maxValue()); }
+  bool hasNonDeltaLobes() const override { return reflects_; }
   bool readsUv() const override { return !reflectance_->isConstant(); }
 
  private:
@@ -28,6 +31,7 @@ class Lambertian final : public Material {
   bool finishSample(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi, float pdf, BsdfSample& out) const;
 
   std::shared_ptr<const Texture> reflectance_;
+  bool reflects_;  // some channel of the reflectance is non-zero somewhere
 };
 
 }  // namespace ember

@@ -12,14 +12,14 @@
 //
 // Tolerances: statistical checks allow kSigmas standard errors; exact checks allow float rounding.
 
+#include "core/rng.h"
+#include "core/sampling.h"
 #include "materials/fresnel.h"
 #include "materials/lambertian.h"
 #include "materials/mixed.h"
 #include "materials/phong.h"
 #include "materials/specular.h"
 #include "materials/texture.h"
-#include "core/rng.h"
-#include "core/sampling.h"
 
 #include <gtest/gtest.h>
 
@@ -614,6 +614,31 @@ TEST(MaterialMixed, TransmissionTotallyReflectsInside) {
   EXPECT_EQ(s.eta, 1.0f);
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(s.weight[k], 1.0f, kFloatTol);
   EXPECT_FALSE(mixed.sample(hit, wo, next2(rng), 0.9f, s)) << "uLobe past kt absorbs";
+}
+
+}  // namespace
+}  // namespace ember
+
+namespace ember {
+namespace {
+
+// evalPdf is what next-event estimation calls; materials that override it to share work must
+// return exactly eval and pdf, on both sides, above and below the horizon.
+TEST(MaterialEvalPdf, EqualsEvalAndPdf) {
+  const SurfaceHit hit = flatHit();
+  for (const MaterialCase& mc : materialCases()) {
+    Rng rng(29, 5);
+    for (const Vec3& wo : woDirections()) {
+      SCOPED_TRACE(mc.name + ", wo = " + str(wo));
+      for (int i = 0; i < 500; ++i) {
+        const Vec3 wi = sampleUniformSphere(next2(rng));
+        float pdf = -1.0f;
+        const Color f = mc.material->evalPdf(hit, wo, wi, pdf);
+        ASSERT_EQ(pdf, mc.material->pdf(hit, wo, wi)) << "wi " << str(wi);
+        ASSERT_EQ(f, mc.material->eval(hit, wo, wi)) << "wi " << str(wi);
+      }
+    }
+  }
 }
 
 }  // namespace
