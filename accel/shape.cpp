@@ -47,6 +47,18 @@ DoublePlane DoublePlane::through(const Vec3& a, const Vec3& b, const Vec3& c) {
   return plane;
 }
 
+PlaneCoordinates PlaneCoordinates::of(const Vec3& v0, const Vec3& v1, const Vec3& v2) {
+  PlaneCoordinates c;
+  c.v0 = glm::dvec3(v0);
+  const glm::dvec3 e1 = glm::dvec3(v1) - c.v0, e2 = glm::dvec3(v2) - c.v0;
+  const glm::dvec3 normal = glm::cross(e1, e2);
+  const double len2 = glm::dot(normal, normal);
+  if (!(len2 > 0.0)) return c;  // never used: no ray is settled on a triangle without area
+  c.g1 = glm::cross(e2, normal) / len2;
+  c.g2 = glm::cross(normal, e1) / len2;
+  return c;
+}
+
 SurfacePoint DoublePlane::project(const Vec3& p) const {
   const glm::dvec3 dp(p);
   return roundedPoint(dp - (glm::dot(n, dp) - d) * n);

@@ -64,9 +64,9 @@ class Shape {
   // Closest hit with t in (tMin, tMax); false when there is none.
   virtual bool intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const = 0;
 
-  // The live lanes of an Embree packet that may hit the shape (bit i for lane i); intersect()
-  // decides each of them. Shapes with a SIMD filter (accel/shape_lanes.h) clear the bits of
-  // lanes that certainly miss; the default keeps every live lane.
+  // The live lanes of an Embree packet that may hit the shape (bit i for lane i), for the default
+  // intersectLanes. Shapes with a SIMD filter (accel/shape_lanes.h) clear the bits of lanes that
+  // certainly miss; the default keeps every live lane.
   virtual uint32_t candidateLanes(const RayLanes& rays) const;
 
   // The closest hit of each live lane with t in (tnear, tfar), for Embree's callbacks: what a
@@ -75,16 +75,16 @@ class Shape {
   // their edges in their lane kernel and run intersect() on the rest.
   virtual void intersectLanes(const RayLanes& rays, LaneHits& out) const;
 
-  // The texture coordinates of a hit that intersect() reported. Shapes whose UV needs more than
-  // the closest hit's parameters (the sphere's inverse trigonometry) compute it here, once for
-  // the hit that counts rather than for every candidate Embree tests.
+  // The texture coordinates of a hit that intersect() or intersectLanes() reported. Shapes whose UV needs
+  // more than the closest hit's parameters (the sphere's inverse trigonometry) compute it here, once for the
+  // hit that counts rather than for every candidate Embree tests.
   virtual Vec2 surfaceUv(const LocalHit& hit) const { return hit.uv; }
 
   // Moves a hit point p = o + t d, which float rounding of t leaves up to ~ulp(t) off the surface,
   // onto the surface as intersect() sees it (computed in double from the same float parameters),
   // so that its error is the rounding of its own coordinates, however far the ray travelled
   // (PBRT4 section 6.8.5 re-projects sphere hits the same way): rays then leave a surface seen from
-  // afar as closely as one seen from nearby. `hit` is what intersect() reported at p.
+  // afar as closely as one seen from nearby. `hit` is what intersectLanes() reported at p.
   // Closed shapes with edges (capped cylinders and cones, boxes) also keep the point a few error
   // bounds away from each edge, on the side of the face that was hit: within rounding of an edge a
   // point is ambiguous, and a ray offset into the shape from the far side of the edge would start
@@ -123,17 +123,34 @@ struct DoublePlane {
   // Whether the ray meets the plane at a t in (tMin, tMax): a cheap first test for flat shapes,
   // which rejects the many shadow rays that end just short of an emitter on this plane.
   bool crossedWithin(const Ray& ray, float tMin, float tMax) const {
-    float t;
-    return crossedWithin(ray, tMin, tMax, t);
-  }
-  // The same, with the crossing's t (rounded to float) when it is within the interval.
-  bool crossedWithin(const Ray& ray, float tMin, float tMax, float& tHit) const {
     const glm::dvec3 dir(ray.dir);
     const double denom = glm::dot(n, dir);
     if (denom == 0.0) return false;
     const double t = (d - glm::dot(n, glm::dvec3(ray.origin))) / denom;
-    tHit = float(t);
     return t > double(tMin) && t < double(tMax);
+  }
+  // The same, also writing the crossing's t (whether or not it is within the interval), measured
+  // from `anchor`, a point of the plane near the shape (a vertex): t = n.(anchor - o) / n.dir then
+  // cancels relative to the distance from the shape, not from the origin (as Moller-Trumbore does),
+  // which keeps a short t accurate far from the origin. anchor - o is exact in double.
+  bool crossedWithin(const Ray& ray, float tMin, float tMax, const glm::dvec3& anchor, double& t) const {
+    const double denom = glm::dot(n, glm::dvec3(ray.dir));
+    if (denom == 0.0) return false;
+    t = glm::dot(n, anchor - glm::dvec3(ray.origin)) / denom;
+    return t > double(tMin) && t < double(tMax);
+  }
+};
+
+// Coordinates in a triangle's plane, in double: a point p of the plane is v0 + b1 (v1 - v0) +
+// b2 (v2 - v0) with b_k = dot(p - v0, g_k), where g1, g2 are the dual vectors of the edges.
+// Moller-Trumbore's u and v are these b1 and b2 of the crossing point.
+struct PlaneCoordinates {
+  glm::dvec3 v0{0.0}, g1{0.0}, g2{0.0};
+
+  static PlaneCoordinates of(const Vec3& v0, const Vec3& v1, const Vec3& v2);
+  Vec2 at(const glm::dvec3& p) const {
+    const glm::dvec3 rel = p - v0;
+    return Vec2(float(glm::dot(rel, g1)), float(glm::dot(rel, g2)));
   }
 };
 

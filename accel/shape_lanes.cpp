@@ -11,7 +11,7 @@ HWY_BEFORE_NAMESPACE();
 namespace ember::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-using D = hn::ScalableTag<float>;
+using D = hn::CappedTag<float, RayLanes::kMaxLanes>;  // never wider than RayLanes' arrays
 using V = hn::Vec<D>;
 using M = hn::Mask<D>;
 
@@ -65,8 +65,8 @@ HWY_INLINE uint32_t maskBits(D d, M m) {
   return bits;
 }
 
-// The rays are read in blocks of Lanes(d); RayLanes arrays hold kMaxLanes entries, so a block
-// never reads past them, and lanes at or beyond n are not live.
+// The rays are read in blocks of Lanes(d), which D caps at kMaxLanes and which divides it: a block
+// never reads past RayLanes' arrays, and lanes at or beyond n are not live.
 template <typename Block>
 HWY_INLINE uint32_t forEachBlock(D d, const RayLanes& rays, Block block) {
   const unsigned step = unsigned(hn::Lanes(d));
@@ -86,7 +86,6 @@ void TriangleLanesKernel(const RayLanes& rays, const TriangleFilter& tri, Triang
   const V planeD = hn::Set(d, tri.d), dError = hn::Set(d, tri.dError);
   const V v0Max = hn::Set(d, tri.v0Max), g1Sum = hn::Set(d, tri.g1Sum), g2Sum = hn::Set(d, tri.g2Sum);
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0f);
-  const V baryTolerance = hn::Set(d, TriangleLanes::kBarycentricError);
   const unsigned step = unsigned(hn::Lanes(d));
   out.candidates = out.inside = 0;
   for (unsigned i = 0; i < rays.n; i += step) {
@@ -135,10 +134,7 @@ void TriangleLanesKernel(const RayLanes& rays, const TriangleFilter& tri, Triang
         tri.parallelogram
             ? hn::And(hn::Lt(hn::Add(b1, b1Error), one), hn::Lt(hn::Add(b2, b2Error), one))
             : hn::Lt(hn::Add(hn::Add(b1, b2), hn::Add(hn::Add(b1Error, b2Error), hn::Set(d, gamma(2)))), one);
-    const M accurate = hn::Lt(hn::Add(b1Error, b2Error), baryTolerance);
-    const M inside = hn::And(hn::And(hn::Gt(slack, zero), accurate), hn::And(above, within));
-    hn::StoreU(b1, d, out.b1 + i);
-    hn::StoreU(b2, d, out.b2 + i);
+    const M inside = hn::And(hn::Gt(slack, zero), hn::And(above, within));
     out.candidates |= maskBits(d, hn::AndNot(certainMiss, b.live)) << i;
     out.inside |= maskBits(d, hn::And(b.live, inside)) << i;
   }

@@ -5,12 +5,12 @@
 // time by HWY_DYNAMIC_DISPATCH) and carries a conservative bound on its rounding error, so it
 // rejects only rays that certainly miss. The few that may hit are then intersected by the shape's
 // scalar, double-precision routine. The flat shapes' kernel also says which rays certainly meet
-// the shape inside its edges, away from them by more than the rounding error; for those the hit is
-// settled without the exact routine (Shape::intersectLanes): its t comes from the shape's
-// double-precision plane, so it is as accurate as before. Single rays take the same route as
-// packets, so both find the same hits bit for bit, and the robustness of the double-precision
-// routines (no acne, no leaks at grazing angles) carries over to the rays near edges, where it
-// matters (tests/test_shape_lanes.cpp).
+// the shape inside its edges, farther from them than the rounding error; for those the hit is
+// settled without the exact routine (Shape::intersectLanes): its t and barycentrics come from
+// the shape's double-precision plane, as accurate as Moller-Trumbore's. Single rays take the same
+// route as packets, so both find the same hits bit for bit, and the double-precision routines'
+// robustness (no acne, no leaks at grazing angles) serves the rays near edges, where it matters
+// (tests/test_shape_lanes.cpp).
 //
 // Error bounds follow the standard model fl(a op b) = (a op b)(1 + d), |d| <= eps = 2^-24, and
 // gamma(n) = n eps / (1 - n eps) for sums and dot products of n terms (Higham 2002, ch. 3;
@@ -64,15 +64,10 @@ struct TriangleLanes {
   // Bit i set: live lane i may hit the triangle (DoublePlane::crossedWithin and intersectTriangle
   // might both succeed); clear: it certainly misses.
   uint32_t candidates = 0;
-  // Bit i set: lane i meets the triangle's plane certainly inside the triangle (or parallelogram),
-  // whatever its t, and its barycentrics b1, b2 are within kBarycentricError of the exact ones.
+  // Bit i set: candidate lane i meets the triangle's plane certainly inside the triangle (or
+  // parallelogram). The verdict depends on the ray alone, not on its interval (tnear, tfar), so
+  // the hit a lane gets does not depend on the order Embree visits the shapes in.
   uint32_t inside = 0;
-  alignas(64) float b1[RayLanes::kMaxLanes];
-  alignas(64) float b2[RayLanes::kMaxLanes];
-
-  // Barycentrics this close are as good as the exact ones for texture lookups: 1/16 of a texel
-  // of a 4096-texel texture.
-  static constexpr float kBarycentricError = 0x1p-16f;
 };
 
 void triangleLanes(const RayLanes& rays, const TriangleFilter& tri, TriangleLanes& out);

@@ -42,6 +42,7 @@ Triangle::Triangle(const std::array<Vec3, 3>& v, const std::array<Vec2, 3>& uv)
       normal_(frontNormal(v[0], v[1], v[2])),
       plane_(DoublePlane::through(v[0], v[1], v[2])),
       filter_(TriangleFilter::of(v[0], v[1], v[2], plane_)),
+      coords_(PlaneCoordinates::of(v[0], v[1], v[2])),
       area_(triangleArea(v[0], v[1], v[2])) {}
 
 Bounds Triangle::bounds() const {
@@ -75,15 +76,18 @@ void Triangle::intersectLanes(const RayLanes& rays, LaneHits& out) const {
     const unsigned i = unsigned(__builtin_ctz(bits));
     const Ray ray = rays.ray(i);
     LocalHit& h = out.hit[i];
-    bool hit;
-    if ((lanes.inside >> i) & 1u) {
-      hit = plane_.crossedWithin(ray, rays.tnear[i], ray.tMax, h.t);
+    double t;
+    if (!((lanes.inside >> i) & 1u)) {
+      if (intersect(ray, rays.tnear[i], ray.tMax, h)) out.mask |= 1u << i;
+    } else if (plane_.crossedWithin(ray, rays.tnear[i], ray.tMax, coords_.v0, t)) {
+      // Certainly inside: the hit is where the ray crosses the plane, and its barycentrics are
+      // the crossing point's plane coordinates, both in double as Moller-Trumbore has them.
+      const Vec2 b = coords_.at(glm::dvec3(ray.origin) + t * glm::dvec3(ray.dir));
+      h.t = float(t);
       h.ng = normal_;
-      h.uv = (1.0f - lanes.b1[i] - lanes.b2[i]) * uv_[0] + lanes.b1[i] * uv_[1] + lanes.b2[i] * uv_[2];
-    } else {
-      hit = intersect(ray, rays.tnear[i], ray.tMax, h);
+      h.uv = (1.0f - b.x - b.y) * uv_[0] + b.x * uv_[1] + b.y * uv_[2];
+      out.mask |= 1u << i;
     }
-    if (hit) out.mask |= 1u << i;
   }
 }
 
@@ -150,9 +154,12 @@ Quad::Quad(const std::array<Vec3, 4>& v, const std::array<Vec2, 4>& uv)
   sampling_ = QuadSampling::of(corners, rectangle_, normal_, area0_, area1_);
   if (singleFilter_) {
     filters_[0] = filters_[1] = TriangleFilter::of(v[0], v[1], v[3], planes_[0], true);
+    coords_[0] = coords_[1] = PlaneCoordinates::of(v[0], v[1], v[3]);
   } else {
     filters_[0] = TriangleFilter::of(v[0], v[1], v[2], planes_[0]);
     filters_[1] = TriangleFilter::of(v[0], v[2], v[3], planes_[1]);
+    coords_[0] = PlaneCoordinates::of(v[0], v[1], v[2]);
+    coords_[1] = PlaneCoordinates::of(v[0], v[2], v[3]);
   }
 }
 
@@ -175,62 +182,88 @@ bool Quad::intersectHalf(int half, const Ray& ray, float tMin, float tMax, Local
   return true;
 }
 
+// A quad that is not an exact parallelogram may be folded along v0-v2 (its vertices need only
+// be coplanar to 1e-4 of its size), so a ray near grazing can cross both halves: the closer wins.
 bool Quad::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const {
-  return intersectHalf(0, ray, tMin, tMax, hit) || intersectHalf(1, ray, tMin, tMax, hit);
+  if (!intersectHalf(0, ray, tMin, tMax, hit)) return intersectHalf(1, ray, tMin, tMax, hit);
+  LocalHit second;
+  if (!singleFilter_ && intersectHalf(1, ray, tMin, hit.t, second)) hit = second;
+  return true;
 }
 
-bool Quad::settledHit(int half, const Ray& ray, float tMin, float tMax, float b1, float b2,
-                      LocalHit& hit) const {
-  if (!planes_[half].crossedWithin(ray, tMin, tMax, hit.t)) return false;
+bool Quad::settledHit(int half, const Ray& ray, float tMin, float tMax, LocalHit& hit) const {
+  double t;
+  if (!planes_[half].crossedWithin(ray, tMin, tMax, coords_[half].v0, t)) return false;
+  Vec2 b = coords_[half].at(glm::dvec3(ray.origin) + t * glm::dvec3(ray.dir));
+  if (singleFilter_) {
+    // (s, r) = b are the parallelogram's coordinates along v1 - v0 and v3 - v0. The half
+    // (v0, v1, v2) is s >= r, with barycentrics (s - r, r); the other has (s, r - s).
+    half = b.x >= b.y ? 0 : 1;
+    b = half == 0 ? Vec2(b.x - b.y, b.y) : Vec2(b.x, b.y - b.x);
+  }
+  hit.t = float(t);
   hit.ng = normal_;
-  hit.uv = (1.0f - b1 - b2) * uv_[0] + b1 * uv_[half == 0 ? 1 : 2] + b2 * uv_[half == 0 ? 2 : 3];
+  hit.uv = (1.0f - b.x - b.y) * uv_[0] + b.x * uv_[half == 0 ? 1 : 2] + b.y * uv_[half == 0 ? 2 : 3];
   return true;
+}
+
+// A half without area (a quad given as a triangle) is never hit; its filter, with NaN dual
+// vectors, would keep every lane.
+void Quad::halfLanes(int half, const RayLanes& rays, TriangleLanes& out) const {
+  if (!((half == 0 ? area0_ : area1_) > 0.0f)) {
+    out.candidates = out.inside = 0;
+    return;
+  }
+  triangleLanes(rays, filters_[half], out);
 }
 
 uint32_t Quad::candidateLanes(const RayLanes& rays) const {
   TriangleLanes lanes;
-  triangleLanes(rays, filters_[0], lanes);
+  halfLanes(0, rays, lanes);
   if (singleFilter_) return lanes.candidates;
   const uint32_t first = lanes.candidates;
-  triangleLanes(rays, filters_[1], lanes);
+  halfLanes(1, rays, lanes);
   return first | lanes.candidates;
 }
 
 // Each half is settled by its kernel where the kernel is certain, and tested exactly where not;
-// as in intersect(), the first half wins when both are hit.
+// as in intersect(), the closer half wins when both are hit.
 void Quad::intersectLanes(const RayLanes& rays, LaneHits& out) const {
   out.mask = 0;
   TriangleLanes first;
-  triangleLanes(rays, filters_[0], first);
+  halfLanes(0, rays, first);
   if (singleFilter_) {
-    // (s, r) = (b1, b2) are the parallelogram's coordinates along v1 - v0 and v3 - v0. The half
-    // (v0, v1, v2) is s >= r, with barycentrics (s - r, r); the other has (s, r - s).
     for (uint32_t bits = first.candidates; bits != 0; bits &= bits - 1) {
       const unsigned i = unsigned(__builtin_ctz(bits));
       const Ray ray = rays.ray(i);
-      const float tMin = rays.tnear[i], s = first.b1[i], r = first.b2[i];
+      const float tMin = rays.tnear[i];
       LocalHit& h = out.hit[i];
-      const bool hit = ((first.inside >> i) & 1u) ? (s >= r ? settledHit(0, ray, tMin, ray.tMax, s - r, r, h)
-                                                            : settledHit(1, ray, tMin, ray.tMax, s, r - s, h))
+      const bool hit = ((first.inside >> i) & 1u) ? settledHit(0, ray, tMin, ray.tMax, h)
                                                   : intersect(ray, tMin, ray.tMax, h);
       if (hit) out.mask |= 1u << i;
     }
     return;
   }
   TriangleLanes second;
-  triangleLanes(rays, filters_[1], second);
+  halfLanes(1, rays, second);
   for (uint32_t bits = first.candidates | second.candidates; bits != 0; bits &= bits - 1) {
     const unsigned i = unsigned(__builtin_ctz(bits));
     const uint32_t bit = 1u << i;
     const Ray ray = rays.ray(i);
     const float tMin = rays.tnear[i];
     LocalHit& h = out.hit[i];
-    auto half = [&](int k, const TriangleLanes& lanes) {
+    auto half = [&](int k, const TriangleLanes& lanes, float tMax, LocalHit& hit) {
       if (!(lanes.candidates & bit)) return false;
-      if (lanes.inside & bit) return settledHit(k, ray, tMin, ray.tMax, lanes.b1[i], lanes.b2[i], h);
-      return intersectHalf(k, ray, tMin, ray.tMax, h);
+      if (lanes.inside & bit) return settledHit(k, ray, tMin, tMax, hit);
+      return intersectHalf(k, ray, tMin, tMax, hit);
     };
-    if (half(0, first) || half(1, second)) out.mask |= bit;
+    LocalHit other;
+    if (half(0, first, ray.tMax, h)) {
+      if (half(1, second, h.t, other)) h = other;
+    } else if (!half(1, second, ray.tMax, h)) {
+      continue;
+    }
+    out.mask |= bit;
   }
 }
 

@@ -39,6 +39,7 @@ class Triangle final : public Shape {
   Vec3 normal_;
   DoublePlane plane_;
   TriangleFilter filter_;
+  PlaneCoordinates coords_;
   float area_;
 };
 
@@ -62,18 +63,22 @@ class Quad final : public Shape {
   bool isRectangle() const { return rectangle_; }
 
  private:
+  // The lane kernel of one half's filter.
+  void halfLanes(int half, const RayLanes& rays, TriangleLanes& out) const;
   // The exact test of one half, (v0, v1, v2) or (v0, v2, v3).
   bool intersectHalf(int half, const Ray& ray, float tMin, float tMax, LocalHit& hit) const;
-  // A hit settled by the lane kernel: t where the ray crosses the half's plane, if within the
-  // interval, and the uv of the half's barycentrics (b1, b2) of its second and third vertex.
-  bool settledHit(int half, const Ray& ray, float tMin, float tMax, float b1, float b2, LocalHit& hit) const;
+  // A hit the lane kernel settled as certainly inside `half` (the parallelogram, for a single
+  // filter): t where the ray crosses the half's plane, if within the interval, and the UV of the
+  // crossing point's barycentrics.
+  bool settledHit(int half, const Ray& ray, float tMin, float tMax, LocalHit& hit) const;
 
   bool rectangle_;
   std::array<Vec3, 4> v_;
   std::array<Vec2, 4> uv_;
   Vec3 normal_;
-  DoublePlane planes_[2];      // of the halves (v0,v1,v2) and (v0,v2,v3)
-  TriangleFilter filters_[2];  // of the same halves, or twice the one of the whole parallelogram
+  DoublePlane planes_[2];       // of the halves (v0,v1,v2) and (v0,v2,v3)
+  TriangleFilter filters_[2];   // of the same halves, or twice the one of the whole parallelogram
+  PlaneCoordinates coords_[2];  // likewise
   bool singleFilter_ = false;
   float area0_, area1_;    // of (v0,v1,v2) and (v0,v2,v3)
   QuadSampling sampling_;  // what the light-sampling kernel needs

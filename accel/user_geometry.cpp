@@ -96,6 +96,10 @@ void shapeIntersectCallback(const RTCIntersectFunctionNArguments* args) {
   RTCHitN* hits = RTCRayHitN_HitN(args->rayhit, args->N);
   const unsigned n = args->N;
   intersectPacket(*shape, rays, n, args->valid, [&](unsigned i, const LocalHit& h) {
+    // A hit at exactly the current tfar (its t rounded onto it) ties with the hit found there:
+    // the smaller geomID keeps it, so that the result among analytic shapes does not depend on
+    // the order Embree visits them in, which differs between single rays and packets.
+    if (h.t == RTCRayN_tfar(rays, n, i) && RTCHitN_geomID(hits, n, i) <= args->geomID) return;
     RTCRayN_tfar(rays, n, i) = h.t;
     RTCHitN_Ng_x(hits, n, i) = h.ng.x;
     RTCHitN_Ng_y(hits, n, i) = h.ng.y;

@@ -20,7 +20,7 @@ class Phong final : public Material {
   Color eval(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const override;
   float pdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const override;
   bool sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float uLobe, BsdfSample& out) const override;
-  bool readsUv() const override { return !kd_->isConstant(); }
+  bool readsUv() const override { return !kd_->isConstant(); }  // kd is its only texture
 
  private:
   float diffuseProbability(const Color& kd) const;

@@ -23,6 +23,8 @@ void Scene::build() {
     const uint32_t id = accel_->addShape(entry.shape.get());
     GeometryRecord rec{entry.shape.get(), nullptr,        entry.material,
                        nullptr,           entry.emission, entry.twoSidedEmission};
+    // Analytic shapes have no surface maps and AreaLight's radiance is uniform, so the material
+    // is the only reader of their UV (were emission textures added, they would read it too).
     rec.readsUv = !entry.material || entry.material->readsUv();
     if (!isBlack(entry.emission)) {
       lights.push_back(

@@ -1,9 +1,12 @@
 // The SIMD lane filters of accel/shape_lanes.h may reject a packet lane only if the shape's scalar
-// intersect() misses it: then packets find exactly the hits single rays find. Checked on the rays
-// where float rounding is most likely to mislead a filter: rays leaving a surface from its offset
-// origin (at grazing angles too), shadow rays that stop just short of the shape, rays aimed at
-// points of the surface and at its edges, for shapes tiny and huge, near the origin and far from
-// it. The filters must also reject most rays that miss, or they would save nothing.
+// intersect() misses it, and Shape::intersectLanes (the route of every ray, packets and single
+// rays alike) must find the hit intersect() finds, to rounding, and the same bits for a lane
+// alone as in its block. Checked on the rays where float rounding is most likely to mislead a
+// kernel: rays leaving a surface from its offset origin (at grazing angles too), shadow rays that
+// stop just short of the shape, rays aimed at points of the surface and at its edges, intervals
+// starting just before or past the hit, partial blocks, for shapes tiny and huge, near the origin
+// and far from it. The filters must also reject most rays that miss, and the flat shapes' kernel
+// settle most hits, or they would save nothing.
 #include "accel/box.h"
 #include "accel/cylinder.h"
 #include "accel/flipped_shape.h"
@@ -49,9 +52,8 @@ struct Block {
     tfar[i] = r.tMax;
     valid[i] = live ? -1 : 0;
   }
-  RayLanes lanes() const {
-    return RayLanes{{org[0], org[1], org[2]}, {dir[0], dir[1], dir[2]}, tnear, tfar, valid,
-                    RayLanes::kMaxLanes};
+  RayLanes lanes(unsigned n = RayLanes::kMaxLanes) const {
+    return RayLanes{{org[0], org[1], org[2]}, {dir[0], dir[1], dir[2]}, tnear, tfar, valid, n};
   }
 };
 
@@ -65,7 +67,8 @@ struct Tally {
   // Shape::intersectLanes, the route every ray takes, against intersect() lane by lane.
   int laneDisagrees = 0;  // hit in one, miss in the other: must stay 0
   int laneInexact = 0;    // both hit, but t, normal or uv differ beyond rounding: must stay 0
-  int deadHit = 0;        // dead lanes reported as hits: must stay 0
+  int deadHit = 0;        // dead lanes (or lanes past the block's n) reported as hits: must stay 0
+  int aloneDiffers = 0;   // a lane traced alone gets another hit than in its block: must stay 0
   std::string laneExample;
 };
 
@@ -77,17 +80,24 @@ std::string describe(const Ray& r) {
 }
 
 // Both are the exact hit rounded to float, computed by different double-precision formulas (the
-// plane's crossing against Moller-Trumbore), so t may differ by an ulp; the kernel's float
-// barycentrics are within TriangleLanes::kBarycentricError.
-bool sameHit(const LocalHit& a, const LocalHit& b) {
+// plane's crossing and plane coordinates against Moller-Trumbore), so t and the barycentrics may
+// differ by an ulp, and the texture coordinates by the rounding of their interpolation, whose
+// terms are as large as the vertex UVs (uvScale).
+bool sameHit(const LocalHit& a, const LocalHit& b, float uvScale) {
   const bool t = std::abs(a.t - b.t) <= 2.5e-7f * std::abs(b.t);
-  const bool uv = glm::length(a.uv - b.uv) <= 4.0f * TriangleLanes::kBarycentricError;
+  const float uvRounding = 1e-6f * std::max({uvScale, std::abs(b.uv.x), std::abs(b.uv.y)});
+  const Vec2 du = glm::abs(a.uv - b.uv);
+  const bool uv = std::max(du.x, du.y) <= uvRounding;
   return t && uv && a.ng == b.ng;
+}
+
+bool identical(const LocalHit& a, const LocalHit& b) {
+  return a.t == b.t && a.ng == b.ng && a.uv == b.uv;
 }
 
 using RayMaker = std::function<Ray(Rng&)>;
 
-void check(const Shape& shape, const RayMaker& make, int blocks, uint64_t seed, Tally& t) {
+void check(const Shape& shape, const RayMaker& make, int blocks, uint64_t seed, float uvScale, Tally& t) {
   Rng rng(seed, 3);
   for (int b = 0; b < blocks; ++b) {
     Block block;
@@ -95,21 +105,36 @@ void check(const Shape& shape, const RayMaker& make, int blocks, uint64_t seed, 
     for (unsigned i = 0; i < RayLanes::kMaxLanes; ++i) {
       rays[i] = make(rng);
       block.set(i, rays[i], rng.uniform() < 0.85f);
+      // Some rays start at an interval just before or just past their first hit.
+      LocalHit first;
+      if (rng.uniform() < 0.2f && shape.intersect(rays[i], 0.0f, rays[i].tMax, first))
+        block.tnear[i] = first.t * (rng.uniform() < 0.5f ? 0.999f : 1.001f);
     }
-    const uint32_t bits = shape.candidateLanes(block.lanes());
+    // A third of the blocks are partial (Embree's single rays come as a padded block of one); the
+    // lanes past n are live but must not be reported.
+    const unsigned n = b % 3 == 0 ? 1 + unsigned(rng.uniform() * 15.0f) : RayLanes::kMaxLanes;
+    const uint32_t bits = shape.candidateLanes(block.lanes(n));
     LaneHits laneHits;
-    shape.intersectLanes(block.lanes(), laneHits);
+    shape.intersectLanes(block.lanes(n), laneHits);
     for (unsigned i = 0; i < RayLanes::kMaxLanes; ++i) {
       const bool kept = (bits >> i) & 1u;
       const bool laneHit = (laneHits.mask >> i) & 1u;
-      if (block.valid[i] != -1) {
+      if (block.valid[i] != -1 || i >= n) {
         t.deadKept += kept;
         t.deadHit += laneHit;
         continue;
       }
+      // The same ray as the only live lane of a block gets the same hit, bit for bit.
+      Block alone = block;
+      for (unsigned k = 0; k < RayLanes::kMaxLanes; ++k) alone.valid[k] = k == i ? -1 : 0;
+      LaneHits aloneHits;
+      shape.intersectLanes(alone.lanes(), aloneHits);
+      if (aloneHits.mask != (laneHit ? 1u << i : 0u) ||
+          (laneHit && !identical(aloneHits.hit[i], laneHits.hit[i])))
+        ++t.aloneDiffers;
       LocalHit h;
-      const bool hit = shape.intersect(rays[i], 0.0f, rays[i].tMax, h);
-      if (laneHit != hit || (hit && !sameHit(laneHits.hit[i], h))) {
+      const bool hit = shape.intersect(rays[i], block.tnear[i], rays[i].tMax, h);
+      if (laneHit != hit || (hit && !sameHit(laneHits.hit[i], h, uvScale))) {
         ++(laneHit != hit ? t.laneDisagrees : t.laneInexact);
         if (t.laneExample.empty()) {
           char buf[160];
@@ -178,7 +203,27 @@ std::vector<ShapeCase> cases(const Vec3& at, float s) {
           std::array<Vec3, 4>{at, at + s * u, at + s * (u + w) + 1e-4f * s * glm::cross(u, w), at + s * w},
           quadUv),
       true);
+  add("flipped rotated quad",
+      std::make_unique<FlippedShape>(std::make_unique<Quad>(
+          std::array<Vec3, 4>{at - s * u - s * w, at + s * u - s * w, at + s * u + s * w, at - s * u + s * w},
+          quadUv)),
+      true);
+  // A quad given as a triangle (v3 = v0): its second half has no area.
+  add("quad with an empty half",
+      std::make_unique<Quad>(std::array<Vec3, 4>{at, at + s * u, at + s * (u + w), at}, quadUv), true);
+  // Texture coordinates tiled 100 times, and negative: an error in the barycentrics is magnified.
+  add("axis quad tiled uv",
+      std::make_unique<Quad>(std::array<Vec3, 4>{at + s * Vec3(-1, 0, -1), at + s * Vec3(1, 0, -1),
+                                                 at + s * Vec3(1, 0, 1), at + s * Vec3(-1, 0, 1)},
+                             std::array<Vec2, 4>{Vec2(-50, -50), Vec2(50, -50), Vec2(50, 50), Vec2(-50, 50)}),
+      true);
   const std::array<Vec2, 3> triUv{Vec2(0, 0), Vec2(1, 0), Vec2(0, 1)};
+  add("triangle tiled uv",
+      std::make_unique<Triangle>(
+          std::array<Vec3, 3>{at + s * Vec3(-1, -0.3f, 0.2f), at + s * Vec3(0.9f, 0.1f, -0.4f),
+                              at + s * Vec3(0.1f, 1.1f, 0.3f)},
+          std::array<Vec2, 3>{Vec2(0, 0), Vec2(100, 3), Vec2(-7, 80)}),
+      true);
   add("triangle",
       std::make_unique<Triangle>(
           std::array<Vec3, 3>{at + s * Vec3(-1, -0.3f, 0.2f), at + s * Vec3(0.9f, 0.1f, -0.4f),
@@ -247,13 +292,14 @@ void runAll(const Vec3& at, float size, uint64_t seed) {
     for (const auto& [family, make] : families(*c.shape, c.size, c.center)) {
       SCOPED_TRACE(c.name + ", " + family);
       Tally t;
-      check(*c.shape, make, 400, seed, t);
+      check(*c.shape, make, 400, seed, c.name.find("tiled") != std::string::npos ? 100.0f : 1.0f, t);
       EXPECT_EQ(t.missed, 0) << "the filter rejected " << t.missed << " of " << t.hits
                              << " lanes the scalar routine hits; first: " << t.example;
       EXPECT_EQ(t.deadKept, 0);
       EXPECT_EQ(t.deadHit, 0);
       EXPECT_EQ(t.laneDisagrees, 0) << "first: " << t.laneExample;
       EXPECT_EQ(t.laneInexact, 0) << "first: " << t.laneExample;
+      EXPECT_EQ(t.aloneDiffers, 0);
       if (family != "random") continue;
       if (c.hasFilter) {
         EXPECT_GT(t.rejected, t.misses * 9 / 10) << "rejects too few of " << t.misses << " misses";
@@ -278,6 +324,50 @@ TEST(ShapeLanes, FiltersKeepEveryHitOfHugeShapes) {
 
 TEST(ShapeLanes, FiltersKeepEveryHitFarFromTheOrigin) {
   runAll(Vec3(6e3f, -3.5e3f, 1.1e4f), 2.0f, 4);
+}
+
+}  // namespace
+}  // namespace ember
+
+namespace ember {
+namespace {
+
+// The speed of flat shapes comes from the kernel settling the hits away from their edges: rays
+// aimed at interior points (barycentric margin >= 0.05) from a few sizes away must nearly all be
+// settled, near the origin and far from it.
+TEST(ShapeLanes, KernelSettlesHitsAwayFromEdges) {
+  for (const auto& [at, size] : {std::pair{Vec3(0.0f), 1.0f}, std::pair{Vec3(6e3f, -3.5e3f, 1.1e4f), 2.0f}}) {
+    const Vec3 v0 = at + size * Vec3(-1, -0.3f, 0.2f), v1 = at + size * Vec3(0.9f, 0.1f, -0.4f),
+               v2 = at + size * Vec3(0.1f, 1.1f, 0.3f);
+    const DoublePlane plane = DoublePlane::through(v0, v1, v2);
+    for (const bool parallelogram : {false, true}) {
+      SCOPED_TRACE(std::string(parallelogram ? "parallelogram" : "triangle") + " at " + std::to_string(at.x));
+      const TriangleFilter filter = TriangleFilter::of(v0, v1, v2, plane, parallelogram);
+      const Vec3 n = glm::normalize(glm::cross(v1 - v0, v2 - v0));
+      Rng rng(7, parallelogram);
+      int rays = 0, settled = 0;
+      for (int b = 0; b < 200; ++b) {
+        Block block;
+        for (unsigned i = 0; i < RayLanes::kMaxLanes; ++i) {
+          float b1 = rng.uniform(), b2 = rng.uniform();
+          if (!parallelogram && b1 + b2 > 1.0f) b1 = 1.0f - b1, b2 = 1.0f - b2;
+          // At least 0.05 from every edge.
+          b1 = 0.05f + (parallelogram ? 0.9f : 0.85f) * b1;
+          b2 = 0.05f + (parallelogram ? 0.9f : 0.85f) * b2;
+          const Vec3 target = v0 + b1 * (v1 - v0) + b2 * (v2 - v0);
+          Vec3 w = randomDirection(rng);
+          if (std::abs(glm::dot(w, n)) < 0.1f) w = glm::normalize(w + 0.2f * n);
+          const Vec3 o = target + size * (1.0f + 2.0f * rng.uniform()) * w;
+          block.set(i, Ray{o, glm::normalize(target - o)}, true);
+        }
+        TriangleLanes lanes;
+        triangleLanes(block.lanes(), filter, lanes);
+        rays += int(RayLanes::kMaxLanes);
+        settled += __builtin_popcount(lanes.inside);
+      }
+      EXPECT_GE(settled, rays * 95 / 100) << settled << " of " << rays << " settled";
+    }
+  }
 }
 
 }  // namespace

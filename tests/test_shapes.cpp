@@ -24,6 +24,9 @@
 #include "core/surface_hit.h"
 #include "materials/fresnel.h"
 #include "materials/lambertian.h"
+#include "materials/mixed.h"
+#include "materials/phong.h"
+#include "materials/specular.h"
 #include "materials/texture.h"
 #include "renderer/scene.h"
 
@@ -980,6 +983,16 @@ TEST(SurfaceHitUv, ComputedOnlyForMaterialsThatReadTextures) {
   auto constant = std::make_shared<ConstantTexture>(Color(0.5f));
   EXPECT_TRUE(Lambertian(image).readsUv());
   EXPECT_FALSE(Lambertian(constant).readsUv());
+  EXPECT_TRUE(Phong(image, Color(0.2f), 10.0f).readsUv());
+  EXPECT_FALSE(Phong(constant, Color(0.2f), 10.0f).readsUv());
+  MixedCoefficients mixed;
+  mixed.kd = image;
+  EXPECT_TRUE(Mixed(mixed).readsUv());
+  mixed.kd = constant;
+  EXPECT_FALSE(Mixed(mixed).readsUv());
+  EXPECT_FALSE(Mirror(Color(0.9f)).readsUv());
+  EXPECT_FALSE(Refraction(Color(0.9f), 1.5f, 1.0f).readsUv());
+  EXPECT_FALSE(Dielectric(1.5f, 1.0f).readsUv());
 
   Scene scene;
   const Material* textured = scene.addMaterial("textured", std::make_unique<Lambertian>(image));
