@@ -23,7 +23,9 @@ void shapeBoundsCallback(const RTCBoundsFunctionArguments* args) {
 // A ray packet in Embree's RTCRayN layout (each field an array of N floats, in RTCRay's order),
 // in blocks of RayLanes::kMaxLanes lanes for the shapes' lane filters. Packets of other widths
 // (Embree only sends 16 or 1 here, as Ember casts rtcIntersect16 and rtcIntersect1) are copied
-// into a padded block, so a filter never reads past an array.
+// into a padded block, so a filter never reads past an array. The padded block is the thread's
+// own, zeroed once: a block copies only its live rays' fields (a single ray copies one lane), and
+// the lanes past them keep earlier rays' finite values, never live.
 class PacketLanes {
  public:
   PacketLanes(RTCRayN* rays, unsigned n, const int* valid)
@@ -42,21 +44,21 @@ class PacketLanes {
                       valid_ + first,
                       count};
     }
-    for (unsigned i = 0; i < RayLanes::kMaxLanes; ++i) {
-      const bool in = i < count;
+    Padded& pad = padded();
+    for (unsigned i = 0; i < count; ++i) {
       for (unsigned c = 0; c < 3; ++c) {
-        pad_.org[c][i] = in ? f_[c * n_ + first + i] : 0.0f;
-        pad_.dir[c][i] = in ? f_[(4 + c) * n_ + first + i] : 0.0f;
+        pad.org[c][i] = f_[c * n_ + first + i];
+        pad.dir[c][i] = f_[(4 + c) * n_ + first + i];
       }
-      pad_.tnear[i] = in ? f_[3 * n_ + first + i] : 0.0f;
-      pad_.tfar[i] = in ? f_[8 * n_ + first + i] : 0.0f;
-      pad_.valid[i] = in ? valid_[first + i] : 0;
+      pad.tnear[i] = f_[3 * n_ + first + i];
+      pad.tfar[i] = f_[8 * n_ + first + i];
     }
-    return RayLanes{{pad_.org[0], pad_.org[1], pad_.org[2]},
-                    {pad_.dir[0], pad_.dir[1], pad_.dir[2]},
-                    pad_.tnear,
-                    pad_.tfar,
-                    pad_.valid,
+    for (unsigned i = 0; i < RayLanes::kMaxLanes; ++i) pad.valid[i] = i < count ? valid_[first + i] : 0;
+    return RayLanes{{pad.org[0], pad.org[1], pad.org[2]},
+                    {pad.dir[0], pad.dir[1], pad.dir[2]},
+                    pad.tnear,
+                    pad.tfar,
+                    pad.valid,
                     count};
   }
 
@@ -68,10 +70,13 @@ class PacketLanes {
     alignas(64) float tfar[RayLanes::kMaxLanes];
     alignas(64) int valid[RayLanes::kMaxLanes];
   };
+  static Padded& padded() {
+    thread_local Padded pad{};
+    return pad;
+  }
   float* f_;
   unsigned n_;
   const int* valid_;
-  Padded pad_;
 };
 
 // Calls report(lane, hit) for each live lane of the packet that hits the shape, as the shape's
@@ -80,7 +85,7 @@ class PacketLanes {
 template <typename Report>
 void intersectPacket(const Shape& shape, RTCRayN* rays, unsigned n, const int* valid, Report report) {
   PacketLanes packet(rays, n, valid);
-  LaneHits hits;
+  thread_local LaneHits hits;  // the thread's own: 16 hit records not rebuilt per call
   for (unsigned k = 0; k < packet.blocks(); ++k) {
     shape.intersectLanes(packet.block(k), hits);
     for (uint32_t bits = hits.mask; bits != 0; bits &= bits - 1) {
