@@ -27,10 +27,11 @@ EmbreeAccel::~EmbreeAccel() {
   if (device_) rtcReleaseDevice(device_);
 }
 
-uint32_t EmbreeAccel::addShape(const Shape* shape) {
+uint32_t EmbreeAccel::addShape(const Shape* shape, bool needsUv) {
   RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
   rtcSetGeometryUserPrimitiveCount(geom, 1);
-  rtcSetGeometryUserData(geom, const_cast<Shape*>(shape));
+  shapes_.push_back(std::make_unique<ShapeGeometry>(ShapeGeometry{shape, needsUv}));
+  rtcSetGeometryUserData(geom, shapes_.back().get());
   rtcSetGeometryBoundsFunction(geom, shapeBoundsCallback, nullptr);
   rtcSetGeometryIntersectFunction(geom, shapeIntersectCallback);
   rtcSetGeometryOccludedFunction(geom, shapeOccludedCallback);

@@ -5,12 +5,15 @@
 
 #include "accel/shape.h"
 #include "accel/triangle_mesh.h"
+#include "accel/user_geometry.h"
 
 #include <embree3/rtcore.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <memory>
+#include <vector>
 
 namespace ember {
 
@@ -40,8 +43,9 @@ class EmbreeAccel {
   EmbreeAccel(const EmbreeAccel&) = delete;
   EmbreeAccel& operator=(const EmbreeAccel&) = delete;
 
-  // The pointers must outlive this object.
-  uint32_t addShape(const Shape* shape);
+  // The pointers must outlive this object. `needsUv`: whether the shape's hits need texture
+  // coordinates (accel/shape_lanes.h, RayLanes::needsUv).
+  uint32_t addShape(const Shape* shape, bool needsUv = true);
   uint32_t addMesh(const TriangleMesh* mesh);
   void commit();
 
@@ -56,6 +60,7 @@ class EmbreeAccel {
  private:
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
+  std::vector<std::unique_ptr<ShapeGeometry>> shapes_;  // the user geometries' data
 };
 
 }  // namespace ember

@@ -34,6 +34,9 @@ struct RayLanes {
   const float* tfar;
   const int* valid;  // -1 = live
   unsigned n;
+  // Whether the hits' texture coordinates are wanted: not by shadow rays, nor by shapes whose
+  // material reads no texture. Without, intersectLanes may leave a hit's uv at (0, 0).
+  bool needsUv = true;
 
   Ray ray(unsigned i) const {
     return Ray{Vec3(org[0][i], org[1][i], org[2][i]), Vec3(dir[0][i], dir[1][i], dir[2][i]), tfar[i]};

@@ -82,10 +82,13 @@ void Triangle::intersectLanes(const RayLanes& rays, LaneHits& out) const {
     } else if (plane_.crossedWithin(ray, rays.tnear[i], ray.tMax, coords_.v0, t)) {
       // Certainly inside: the hit is where the ray crosses the plane, and its barycentrics are
       // the crossing point's plane coordinates, both in double as Moller-Trumbore has them.
-      const Vec2 b = coords_.at(glm::dvec3(ray.origin) + t * glm::dvec3(ray.dir));
       h.t = float(t);
       h.ng = normal_;
-      h.uv = (1.0f - b.x - b.y) * uv_[0] + b.x * uv_[1] + b.y * uv_[2];
+      h.uv = Vec2(0.0f);
+      if (rays.needsUv) {
+        const Vec2 b = coords_.at(glm::dvec3(ray.origin) + t * glm::dvec3(ray.dir));
+        h.uv = (1.0f - b.x - b.y) * uv_[0] + b.x * uv_[1] + b.y * uv_[2];
+      }
       out.mask |= 1u << i;
     }
   }
@@ -191,9 +194,13 @@ bool Quad::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) cons
   return true;
 }
 
-bool Quad::settledHit(int half, const Ray& ray, float tMin, float tMax, LocalHit& hit) const {
+bool Quad::settledHit(int half, const Ray& ray, float tMin, float tMax, bool needsUv, LocalHit& hit) const {
   double t;
   if (!planes_[half].crossedWithin(ray, tMin, tMax, coords_[half].v0, t)) return false;
+  hit.t = float(t);
+  hit.ng = normal_;
+  hit.uv = Vec2(0.0f);
+  if (!needsUv) return true;
   Vec2 b = coords_[half].at(glm::dvec3(ray.origin) + t * glm::dvec3(ray.dir));
   if (singleFilter_) {
     // (s, r) = b are the parallelogram's coordinates along v1 - v0 and v3 - v0. The half
@@ -201,8 +208,6 @@ bool Quad::settledHit(int half, const Ray& ray, float tMin, float tMax, LocalHit
     half = b.x >= b.y ? 0 : 1;
     b = half == 0 ? Vec2(b.x - b.y, b.y) : Vec2(b.x, b.y - b.x);
   }
-  hit.t = float(t);
-  hit.ng = normal_;
   hit.uv = (1.0f - b.x - b.y) * uv_[0] + b.x * uv_[half == 0 ? 1 : 2] + b.y * uv_[half == 0 ? 2 : 3];
   return true;
 }
@@ -238,7 +243,7 @@ void Quad::intersectLanes(const RayLanes& rays, LaneHits& out) const {
       const Ray ray = rays.ray(i);
       const float tMin = rays.tnear[i];
       LocalHit& h = out.hit[i];
-      const bool hit = ((first.inside >> i) & 1u) ? settledHit(0, ray, tMin, ray.tMax, h)
+      const bool hit = ((first.inside >> i) & 1u) ? settledHit(0, ray, tMin, ray.tMax, rays.needsUv, h)
                                                   : intersect(ray, tMin, ray.tMax, h);
       if (hit) out.mask |= 1u << i;
     }
@@ -254,7 +259,7 @@ void Quad::intersectLanes(const RayLanes& rays, LaneHits& out) const {
     LocalHit& h = out.hit[i];
     auto half = [&](int k, const TriangleLanes& lanes, float tMax, LocalHit& hit) {
       if (!(lanes.candidates & bit)) return false;
-      if (lanes.inside & bit) return settledHit(k, ray, tMin, tMax, hit);
+      if (lanes.inside & bit) return settledHit(k, ray, tMin, tMax, rays.needsUv, hit);
       return intersectHalf(k, ray, tMin, tMax, hit);
     };
     LocalHit other;

@@ -69,8 +69,8 @@ class Quad final : public Shape {
   bool intersectHalf(int half, const Ray& ray, float tMin, float tMax, LocalHit& hit) const;
   // A hit the lane kernel settled as certainly inside `half` (the parallelogram, for a single
   // filter): t where the ray crosses the half's plane, if within the interval, and the UV of the
-  // crossing point's barycentrics.
-  bool settledHit(int half, const Ray& ray, float tMin, float tMax, LocalHit& hit) const;
+  // crossing point's barycentrics (with needsUv; else (0, 0)).
+  bool settledHit(int half, const Ray& ray, float tMin, float tMax, bool needsUv, LocalHit& hit) const;
 
   bool rectangle_;
   std::array<Vec3, 4> v_;

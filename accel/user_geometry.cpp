@@ -7,7 +7,7 @@
 namespace ember {
 
 void shapeBoundsCallback(const RTCBoundsFunctionArguments* args) {
-  const auto* shape = static_cast<const Shape*>(args->geometryUserPtr);
+  const auto* shape = static_cast<const ShapeGeometry*>(args->geometryUserPtr)->shape;
   const Bounds b = shape->bounds();
   // Pad by a relative epsilon so float rounding of the exact bounds never culls a true hit.
   const Vec3 pad = 1e-5f * (glm::abs(b.lower) + glm::abs(b.upper)) + Vec3(1e-7f);
@@ -28,8 +28,8 @@ void shapeBoundsCallback(const RTCBoundsFunctionArguments* args) {
 // the lanes past them keep earlier rays' finite values, never live.
 class PacketLanes {
  public:
-  PacketLanes(RTCRayN* rays, unsigned n, const int* valid)
-      : f_(reinterpret_cast<float*>(rays)), n_(n), valid_(valid) {}
+  PacketLanes(RTCRayN* rays, unsigned n, const int* valid, bool needsUv)
+      : f_(reinterpret_cast<float*>(rays)), n_(n), valid_(valid), needsUv_(needsUv) {}
 
   unsigned blocks() const { return (n_ + RayLanes::kMaxLanes - 1) / RayLanes::kMaxLanes; }
   RayLanes block(unsigned k) {
@@ -42,7 +42,8 @@ class PacketLanes {
                       field(3),
                       field(8),
                       valid_ + first,
-                      count};
+                      count,
+                      needsUv_};
     }
     Padded& pad = padded();
     for (unsigned i = 0; i < count; ++i) {
@@ -59,7 +60,8 @@ class PacketLanes {
                     pad.tnear,
                     pad.tfar,
                     pad.valid,
-                    count};
+                    count,
+                    needsUv_};
   }
 
  private:
@@ -77,14 +79,16 @@ class PacketLanes {
   float* f_;
   unsigned n_;
   const int* valid_;
+  bool needsUv_;
 };
 
 // Calls report(lane, hit) for each live lane of the packet that hits the shape, as the shape's
 // intersectLanes decides it. Single rays take the same route (a padded block of one live lane),
 // so a packet finds exactly the hits single rays find.
 template <typename Report>
-void intersectPacket(const Shape& shape, RTCRayN* rays, unsigned n, const int* valid, Report report) {
-  PacketLanes packet(rays, n, valid);
+void intersectPacket(const Shape& shape, bool needsUv, RTCRayN* rays, unsigned n, const int* valid,
+                     Report report) {
+  PacketLanes packet(rays, n, valid, needsUv);
   thread_local LaneHits hits;  // the thread's own: 16 hit records not rebuilt per call
   for (unsigned k = 0; k < packet.blocks(); ++k) {
     shape.intersectLanes(packet.block(k), hits);
@@ -96,31 +100,33 @@ void intersectPacket(const Shape& shape, RTCRayN* rays, unsigned n, const int* v
 }
 
 void shapeIntersectCallback(const RTCIntersectFunctionNArguments* args) {
-  const auto* shape = static_cast<const Shape*>(args->geometryUserPtr);
+  const auto* geometry = static_cast<const ShapeGeometry*>(args->geometryUserPtr);
   RTCRayN* rays = RTCRayHitN_RayN(args->rayhit, args->N);
   RTCHitN* hits = RTCRayHitN_HitN(args->rayhit, args->N);
   const unsigned n = args->N;
-  intersectPacket(*shape, rays, n, args->valid, [&](unsigned i, const LocalHit& h) {
-    // A hit at exactly the current tfar (its t rounded onto it) ties with the hit found there:
-    // the smaller geomID keeps it, so that the result among analytic shapes does not depend on
-    // the order Embree visits them in, which differs between single rays and packets.
-    if (h.t == RTCRayN_tfar(rays, n, i) && RTCHitN_geomID(hits, n, i) <= args->geomID) return;
-    RTCRayN_tfar(rays, n, i) = h.t;
-    RTCHitN_Ng_x(hits, n, i) = h.ng.x;
-    RTCHitN_Ng_y(hits, n, i) = h.ng.y;
-    RTCHitN_Ng_z(hits, n, i) = h.ng.z;
-    RTCHitN_u(hits, n, i) = h.uv.x;
-    RTCHitN_v(hits, n, i) = h.uv.y;
-    RTCHitN_primID(hits, n, i) = args->primID;
-    RTCHitN_geomID(hits, n, i) = args->geomID;
-    RTCHitN_instID(hits, n, i, 0) = args->context->instID[0];
-  });
+  intersectPacket(*geometry->shape, geometry->needsUv, rays, n, args->valid,
+                  [&](unsigned i, const LocalHit& h) {
+                    // A hit at exactly the current tfar (its t rounded onto it) ties with the hit found
+                    // there: the smaller geomID keeps it, so that the result among analytic shapes does not
+                    // depend on the order Embree visits them in, which differs between single rays and
+                    // packets.
+                    if (h.t == RTCRayN_tfar(rays, n, i) && RTCHitN_geomID(hits, n, i) <= args->geomID) return;
+                    RTCRayN_tfar(rays, n, i) = h.t;
+                    RTCHitN_Ng_x(hits, n, i) = h.ng.x;
+                    RTCHitN_Ng_y(hits, n, i) = h.ng.y;
+                    RTCHitN_Ng_z(hits, n, i) = h.ng.z;
+                    RTCHitN_u(hits, n, i) = h.uv.x;
+                    RTCHitN_v(hits, n, i) = h.uv.y;
+                    RTCHitN_primID(hits, n, i) = args->primID;
+                    RTCHitN_geomID(hits, n, i) = args->geomID;
+                    RTCHitN_instID(hits, n, i, 0) = args->context->instID[0];
+                  });
 }
 
 void shapeOccludedCallback(const RTCOccludedFunctionNArguments* args) {
-  const auto* shape = static_cast<const Shape*>(args->geometryUserPtr);
+  const auto* shape = static_cast<const ShapeGeometry*>(args->geometryUserPtr)->shape;
   // Embree 3 reports an occluded ray by setting tfar to -infinity.
-  intersectPacket(*shape, args->ray, args->N, args->valid,
+  intersectPacket(*shape, false, args->ray, args->N, args->valid,
                   [&](unsigned i, const LocalHit&) { RTCRayN_tfar(args->ray, args->N, i) = -kInfinity; });
 }
 

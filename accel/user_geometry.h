@@ -5,6 +5,14 @@
 
 namespace ember {
 
+class Shape;
+
+// A user geometry's data: the shape, and whether its closest hits need texture coordinates.
+struct ShapeGeometry {
+  const Shape* shape;
+  bool needsUv;
+};
+
 void shapeBoundsCallback(const RTCBoundsFunctionArguments* args);
 void shapeIntersectCallback(const RTCIntersectFunctionNArguments* args);
 void shapeOccludedCallback(const RTCOccludedFunctionNArguments* args);

@@ -20,12 +20,13 @@ void Scene::build() {
   for (auto& light : lights) allLights.push_back(light.get());
 
   for (ShapeEntry& entry : shapes) {
-    const uint32_t id = accel_->addShape(entry.shape.get());
-    GeometryRecord rec{entry.shape.get(), nullptr,        entry.material,
-                       nullptr,           entry.emission, entry.twoSidedEmission};
     // Analytic shapes have no surface maps and AreaLight's radiance is uniform, so the material
     // is the only reader of their UV (were emission textures added, they would read it too).
-    rec.readsUv = !entry.material || entry.material->readsUv();
+    const bool readsUv = !entry.material || entry.material->readsUv();
+    const uint32_t id = accel_->addShape(entry.shape.get(), readsUv);
+    GeometryRecord rec{entry.shape.get(), nullptr,        entry.material,
+                       nullptr,           entry.emission, entry.twoSidedEmission};
+    rec.readsUv = readsUv;
     if (!isBlack(entry.emission)) {
       lights.push_back(
           std::make_unique<AreaLight>(entry.shape.get(), entry.emission, entry.twoSidedEmission));

@@ -69,6 +69,7 @@ struct Tally {
   int laneInexact = 0;    // both hit, but t, normal or uv differ beyond rounding: must stay 0
   int deadHit = 0;        // dead lanes (or lanes past the block's n) reported as hits: must stay 0
   int aloneDiffers = 0;   // a lane traced alone gets another hit than in its block: must stay 0
+  int uvSkipDiffers = 0;  // skipping the UV changes a hit's mask, t or normal: must stay 0
   std::string laneExample;
 };
 
@@ -116,6 +117,12 @@ void check(const Shape& shape, const RayMaker& make, int blocks, uint64_t seed, 
     const uint32_t bits = shape.candidateLanes(block.lanes(n));
     LaneHits laneHits;
     shape.intersectLanes(block.lanes(n), laneHits);
+    // Without texture coordinates (shadow rays, untextured materials) the same hits, t and normals.
+    RayLanes withoutUv = block.lanes(n);
+    withoutUv.needsUv = false;
+    LaneHits noUvHits;
+    shape.intersectLanes(withoutUv, noUvHits);
+    t.uvSkipDiffers += noUvHits.mask != laneHits.mask;
     for (unsigned i = 0; i < RayLanes::kMaxLanes; ++i) {
       const bool kept = (bits >> i) & 1u;
       const bool laneHit = (laneHits.mask >> i) & 1u;
@@ -129,6 +136,8 @@ void check(const Shape& shape, const RayMaker& make, int blocks, uint64_t seed, 
       for (unsigned k = 0; k < RayLanes::kMaxLanes; ++k) alone.valid[k] = k == i ? -1 : 0;
       LaneHits aloneHits;
       shape.intersectLanes(alone.lanes(), aloneHits);
+      if (laneHit && (noUvHits.hit[i].t != laneHits.hit[i].t || noUvHits.hit[i].ng != laneHits.hit[i].ng))
+        ++t.uvSkipDiffers;
       if (aloneHits.mask != (laneHit ? 1u << i : 0u) ||
           (laneHit && !identical(aloneHits.hit[i], laneHits.hit[i])))
         ++t.aloneDiffers;
@@ -300,6 +309,7 @@ void runAll(const Vec3& at, float size, uint64_t seed) {
       EXPECT_EQ(t.laneDisagrees, 0) << "first: " << t.laneExample;
       EXPECT_EQ(t.laneInexact, 0) << "first: " << t.laneExample;
       EXPECT_EQ(t.aloneDiffers, 0);
+      EXPECT_EQ(t.uvSkipDiffers, 0);
       if (family != "random") continue;
       if (c.hasFilter) {
         EXPECT_GT(t.rejected, t.misses * 9 / 10) << "rejects too few of " << t.misses << " misses";
