@@ -54,6 +54,7 @@ PlaneCoordinates PlaneCoordinates::of(const Vec3& v0, const Vec3& v1, const Vec3
   const glm::dvec3 normal = glm::cross(e1, e2);
   const double len2 = glm::dot(normal, normal);
   if (!(len2 > 0.0)) return c;  // never used: no ray is settled on a triangle without area
+  c.hasArea = true;
   c.g1 = glm::cross(e2, normal) / len2;
   c.g2 = glm::cross(normal, e1) / len2;
   return c;

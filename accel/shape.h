@@ -65,8 +65,8 @@ class Shape {
   virtual bool intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const = 0;
 
   // The live lanes of an Embree packet that may hit the shape (bit i for lane i), for the default
-  // intersectLanes. Shapes with a SIMD filter (accel/shape_lanes.h) clear the bits of lanes that
-  // certainly miss; the default keeps every live lane.
+  // intersectLanes (and for the filter tests, on every shape). Shapes with a SIMD filter
+  // (accel/shape_lanes.h) clear the bits of lanes that certainly miss; the default keeps every live lane.
   virtual uint32_t candidateLanes(const RayLanes& rays) const;
 
   // The closest hit of each live lane with t in (tnear, tfar), for Embree's callbacks: what a
@@ -146,6 +146,7 @@ struct DoublePlane {
 // Moller-Trumbore's u and v are these b1 and b2 of the crossing point.
 struct PlaneCoordinates {
   glm::dvec3 v0{0.0}, g1{0.0}, g2{0.0};
+  bool hasArea = false;  // false for a degenerate triangle, whose g1, g2 stay zero
 
   static PlaneCoordinates of(const Vec3& v0, const Vec3& v1, const Vec3& v2);
   Vec2 at(const glm::dvec3& p) const {

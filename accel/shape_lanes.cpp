@@ -191,9 +191,7 @@ TriangleFilter TriangleFilter::of(const Vec3& v0, const Vec3& v1, const Vec3& v2
                                   bool parallelogram) {
   TriangleFilter f;
   f.parallelogram = parallelogram;
-  const glm::dvec3 p0(v0), e1 = glm::dvec3(v1) - p0, e2 = glm::dvec3(v2) - p0;
-  const glm::dvec3 normal = glm::cross(e1, e2);
-  const double len2 = glm::dot(normal, normal);
+  const PlaneCoordinates coords = PlaneCoordinates::of(v0, v1, v2);
   f.v0 = v0;
   f.v0Max = maxComponent(glm::abs(v0));
   f.n = Vec3(plane.n);
@@ -201,9 +199,9 @@ TriangleFilter TriangleFilter::of(const Vec3& v0, const Vec3& v1, const Vec3& v2
   // float(d) is within eps |d| of d; the rounding of n adds eps |n|_1 max|o| <= 2 eps max|o|, which
   // the kernel adds per ray.
   f.dError = 1.01f * 0x1p-24f * std::abs(f.d);
-  if (len2 > 0.0) {
-    f.g1 = Vec3(glm::cross(e2, normal) / len2);
-    f.g2 = Vec3(glm::cross(normal, e1) / len2);
+  if (coords.hasArea) {
+    f.g1 = Vec3(coords.g1);
+    f.g2 = Vec3(coords.g2);
   } else {
     // A degenerate triangle: the scalar test never hits it; NaN keeps every lane a candidate.
     f.g1 = f.g2 = Vec3(std::numeric_limits<float>::quiet_NaN());

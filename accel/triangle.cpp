@@ -29,6 +29,11 @@ bool intersectTriangle(const Ray& ray, const Vec3& v0, const Vec3& v1, const Vec
   return true;
 }
 
+// The texture coordinates at barycentrics (b1, b2) of the second and third vertex.
+static Vec2 uvAt(const Vec2& uv0, const Vec2& uv1, const Vec2& uv2, float b1, float b2) {
+  return (1.0f - b1 - b2) * uv0 + b1 * uv1 + b2 * uv2;
+}
+
 static Vec3 frontNormal(const Vec3& v0, const Vec3& v1, const Vec3& v2) {
   return glm::normalize(glm::cross(v1 - v0, v2 - v0));
 }
@@ -58,7 +63,7 @@ bool Triangle::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) 
     return false;
   hit.t = t;
   hit.ng = normal_;
-  hit.uv = (1.0f - b1 - b2) * uv_[0] + b1 * uv_[1] + b2 * uv_[2];
+  hit.uv = uvAt(uv_[0], uv_[1], uv_[2], b1, b2);
   return true;
 }
 
@@ -87,7 +92,7 @@ void Triangle::intersectLanes(const RayLanes& rays, LaneHits& out) const {
       h.uv = Vec2(0.0f);
       if (rays.needsUv) {
         const Vec2 b = coords_.at(glm::dvec3(ray.origin) + t * glm::dvec3(ray.dir));
-        h.uv = (1.0f - b.x - b.y) * uv_[0] + b.x * uv_[1] + b.y * uv_[2];
+        h.uv = uvAt(uv_[0], uv_[1], uv_[2], b.x, b.y);
       }
       out.mask |= 1u << i;
     }
@@ -181,7 +186,7 @@ bool Quad::intersectHalf(int half, const Ray& ray, float tMin, float tMax, Local
     return false;
   hit.t = t;
   hit.ng = normal_;
-  hit.uv = (1.0f - b1 - b2) * uv_[0] + b1 * uv_[half == 0 ? 1 : 2] + b2 * uv_[half == 0 ? 2 : 3];
+  hit.uv = uvAt(uv_[0], uv_[half == 0 ? 1 : 2], uv_[half == 0 ? 2 : 3], b1, b2);
   return true;
 }
 
@@ -208,7 +213,7 @@ bool Quad::settledHit(int half, const Ray& ray, float tMin, float tMax, bool nee
     half = b.x >= b.y ? 0 : 1;
     b = half == 0 ? Vec2(b.x - b.y, b.y) : Vec2(b.x, b.y - b.x);
   }
-  hit.uv = (1.0f - b.x - b.y) * uv_[0] + b.x * uv_[half == 0 ? 1 : 2] + b.y * uv_[half == 0 ? 2 : 3];
+  hit.uv = uvAt(uv_[0], uv_[half == 0 ? 1 : 2], uv_[half == 0 ? 2 : 3], b.x, b.y);
   return true;
 }
 
