@@ -66,8 +66,7 @@ Wave& threadWave() {
 // Each lane's result does not depend on the order lanes are shaded in.
 void groupByGeometry(Wave& wave, size_t active, size_t geometries) {
   const size_t buckets = geometries + 1;
-  // With many geometries, clearing the buckets would cost more than sorting the wave's keys.
-  if (buckets > 4 * Wave::kSize) {
+  if (buckets > WavefrontIntegrator::kMaxCountingSortBuckets) {
     for (size_t a = 0; a < active; ++a)
       wave.sortKey[a] = uint64_t(wave.closest.geometryOf(a) + 1u) << 16 | a;  // misses (0) first
     std::sort(wave.sortKey.begin(), wave.sortKey.begin() + ptrdiff_t(active));
