@@ -66,7 +66,7 @@ SurfacePoint Cylinder::projectToSurface(const Vec3& p, const LocalHit& hit) cons
   // In the axis frame intersect() uses: x^2 + y^2 = r^2, 0 <= z <= h (kept off the caps' rims).
   const glm::dvec3 s(axis_.s), t(axis_.t), n(axis_.n), rel = glm::dvec3(p) - glm::dvec3(p0_);
   const double x = glm::dot(rel, s), y = glm::dot(rel, t), len = std::sqrt(x * x + y * y);
-  if (!(len > 0.0)) return {p, roundingErrorBound(maxComponent(glm::abs(p)) + radius_ + height_)};
+  if (!(len > 0.0)) return {p, roundingErrorBound(maxAbsComponent(p) + radius_ + height_)};
   const double scale = double(radius_) / len;
   double z = glm::dot(rel, n);
   if (height_ > 2.0f * margin) z = std::clamp(z, double(margin), double(height_ - margin));

@@ -32,7 +32,7 @@ struct RawHit {
 // paths they belong to give non-finite samples, which the film drops.
 inline bool traceable(const Ray& ray) {
   constexpr float kLarge = 1.844e18f;
-  const float m = std::max(maxComponent(glm::abs(ray.origin)), maxComponent(glm::abs(ray.dir)));
+  const float m = std::max(maxAbsComponent(ray.origin), maxAbsComponent(ray.dir));
   return m <= kLarge && !std::isnan(ray.tMax);
 }
 

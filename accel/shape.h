@@ -160,7 +160,7 @@ struct PlaneCoordinates {
 // only to ~1e-7 of their size (float frames and rotations that are not exactly orthonormal).
 inline SurfacePoint roundedPoint(const glm::dvec3& p, float size = 0.0f) {
   const Vec3 f(p);
-  return {f, roundingErrorBound(maxComponent(glm::abs(f)) + size)};
+  return {f, roundingErrorBound(maxAbsComponent(f) + size)};
 }
 
 // How far a projected point is kept from an edge of its face: after the offset along the normal

@@ -146,7 +146,7 @@ void TriangleLanesKernel(const RayLanes& rays, const TriangleFilter& tri, Triang
 uint32_t SphereCandidates(const RayLanes& rays, const Vec3& center, float radius) {
   const D d;
   const Vec3V c = splat(d, center);
-  const V cMax = hn::Set(d, maxComponent(glm::abs(center)));
+  const V cMax = hn::Set(d, maxAbsComponent(center));
   const V r2 = hn::Set(d, radius * radius);
   return forEachBlock(d, rays, [&](const LaneBlock& b) {
     // disc = (oc.dir)^2 - |dir|^2 (|oc|^2 - r^2), the sign of solveQuadratic's discriminant / 4.
@@ -193,7 +193,7 @@ TriangleFilter TriangleFilter::of(const Vec3& v0, const Vec3& v1, const Vec3& v2
   f.parallelogram = parallelogram;
   const PlaneCoordinates coords = PlaneCoordinates::of(v0, v1, v2);
   f.v0 = v0;
-  f.v0Max = maxComponent(glm::abs(v0));
+  f.v0Max = maxAbsComponent(v0);
   f.n = Vec3(plane.n);
   f.d = float(plane.d);
   // float(d) is within eps |d| of d; the rounding of n adds eps |n|_1 max|o| <= 2 eps max|o|, which

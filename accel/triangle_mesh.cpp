@@ -36,7 +36,7 @@ Vec3 TriangleMesh::pointAt(uint32_t prim, float b1, float b2) const {
 float TriangleMesh::pointError(uint32_t prim) const {
   const glm::uvec3& idx = indices[prim];
   float m = 0.0f;
-  for (uint32_t v : {idx.x, idx.y, idx.z}) m = std::max(m, maxComponent(glm::abs(positions[v])));
+  for (uint32_t v : {idx.x, idx.y, idx.z}) m = std::max(m, maxAbsComponent(positions[v]));
   return roundingErrorBound(m);
 }
 

@@ -10,7 +10,7 @@ void shapeBoundsCallback(const RTCBoundsFunctionArguments* args) {
   const auto* shape = static_cast<const ShapeGeometry*>(args->geometryUserPtr)->shape;
   const Bounds b = shape->bounds();
   // Pad by a relative epsilon so float rounding of the exact bounds never culls a true hit.
-  const Vec3 pad = 1e-5f * (glm::abs(b.lower) + glm::abs(b.upper)) + Vec3(1e-7f);
+  const Vec3 pad = 1e-5f * (absolute(b.lower) + absolute(b.upper)) + Vec3(1e-7f);
   RTCBounds* out = args->bounds_o;
   out->lower_x = b.lower.x - pad.x;
   out->lower_y = b.lower.y - pad.y;

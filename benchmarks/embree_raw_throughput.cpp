@@ -44,7 +44,7 @@ RayBatch makeRays(const Scene& scene, size_t n) {
     b.closest.push_back(Ray{hit.offsetOrigin(dir), dir});
     const Vec3 target = lightCenter + Vec3(rng.uniform() - 0.5f, 0.0f, rng.uniform() - 0.5f) * 0.5f;
     b.shadow.push_back(spawnRayTo(hit.p, hit.ng, hit.pError, target, Vec3(0.0f, -1.0f, 0.0f),
-                                  roundingErrorBound(maxComponent(glm::abs(target)))));
+                                  roundingErrorBound(maxAbsComponent(target))));
     b.shadowDist.push_back(b.shadow.back().tMax);
   }
   return b;

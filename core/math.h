@@ -22,6 +22,14 @@ inline constexpr float kInfinity = std::numeric_limits<float>::infinity();
 inline float maxComponent(const Vec3& v) {
   return std::max(v.x, std::max(v.y, v.z));
 }
+// Componentwise |v|. glm::abs is `x >= 0 ? x : -x`, which GCC compiles to a branch per component,
+// and on ray directions those branches are unpredictable; fabs is one AND.
+inline Vec3 absolute(const Vec3& v) {
+  return {std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)};
+}
+inline float maxAbsComponent(const Vec3& v) {
+  return maxComponent(absolute(v));
+}
 inline bool isBlack(const Color& c) {
   return c.x == 0.0f && c.y == 0.0f && c.z == 0.0f;
 }

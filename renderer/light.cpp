@@ -50,7 +50,7 @@ bool SpotLight::sample(const Vec3& ref, Vec2, LightSample& out) const {
 // The rounding-error bound of points computed from data inside `b` (a sampled point is a sum of
 // terms no larger than the bounds' coordinates).
 static float errorBoundWithin(const Bounds& b) {
-  return roundingErrorBound(std::max(maxComponent(glm::abs(b.lower)), maxComponent(glm::abs(b.upper))));
+  return roundingErrorBound(std::max(maxAbsComponent(b.lower), maxAbsComponent(b.upper)));
 }
 
 AreaLight::AreaLight(const Shape* shape, const Color& radiance, bool twoSided)

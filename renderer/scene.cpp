@@ -97,7 +97,7 @@ void Scene::surfaceHit(const Ray& ray, const RawHit& raw, SurfaceHit& hit) const
     hit.ng = raw.ng;
     const LocalHit local{raw.t, raw.ng, raw.uv};
     hit.uv = rec.readsUv ? rec.shape->surfaceUv(local) : Vec2(0.0f);
-    const float magnitude = maxComponent(glm::abs(hit.p));
+    const float magnitude = maxAbsComponent(hit.p);
     if (raw.t > magnitude) {
       const SurfacePoint onSurface = rec.shape->projectToSurface(hit.p, local);
       hit.p = onSurface.p;

@@ -255,7 +255,7 @@ TEST(MaterialSampling, PdfAndWeightMatchEvalAndPdf) {
         const Color f = mc.material->eval(hit, wo, s.wi);
         const bool ok = std::abs(glm::length(s.wi) - 1.0f) < kFloatTol && s.pdf > 0.0f &&
                         std::abs(pdf - s.pdf) <= 1e-4f * s.pdf && s.eta == 1.0f &&
-                        glm::all(glm::lessThanEqual(glm::abs(s.weight - f / s.pdf),
+                        glm::all(glm::lessThanEqual(absolute(s.weight - f / s.pdf),
                                                     1e-4f * (f / s.pdf) + 1e-7f)) &&
                         wo.z * s.wi.z > 0.0f;  // a reflection
         if (!ok) {
@@ -431,7 +431,7 @@ TEST(FresnelDielectric, MatchesAngleFormAndIsReciprocal) {
 
 // wi is wo mirrored about +z / -z: same side, tangential part negated.
 ::testing::AssertionResult isMirrorOf(const Vec3& wo, const Vec3& wi) {
-  if (glm::all(glm::lessThanEqual(glm::abs(wi - Vec3(-wo.x, -wo.y, wo.z)), Vec3(kFloatTol))))
+  if (glm::all(glm::lessThanEqual(absolute(wi - Vec3(-wo.x, -wo.y, wo.z)), Vec3(kFloatTol))))
     return ::testing::AssertionSuccess();
   return ::testing::AssertionFailure() << str(wi) << " is not the mirror image of " << str(wo);
 }
@@ -526,7 +526,7 @@ TEST(MaterialDielectric, ChoosesReflectionWithFresnelProbability) {
         } else {
           ok = ok && isRefractionOf(wo, s.wi, eta) && std::abs(s.eta - eta) <= kFloatTol &&
                std::abs(s.pdf - (1.0 - F)) <= 4.0 * kFloatTol &&
-               glm::all(glm::lessThanEqual(glm::abs(s.weight - Color(1.0f / (eta * eta))), Color(kFloatTol)));
+               glm::all(glm::lessThanEqual(absolute(s.weight - Color(1.0f / (eta * eta))), Color(kFloatTol)));
         }
         if (!ok) {
           ++failures;

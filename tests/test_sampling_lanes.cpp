@@ -149,8 +149,7 @@ TEST(SamplingLanes, RectangleSolidAngleIsAccurateEvenNearItsPlane) {
     // Where the corners' own float rounding is not small against the size (tiny or far-off
     // rectangles), the solid angle seen from near the plane is not defined by the input to 0.5%:
     // the four rounded corners are not coplanar to that precision.
-    if (!quad.isRectangle() || maxComponent(glm::abs(center)) > 10.0f * glm::length(qc.v[2] - qc.v[0]))
-      continue;
+    if (!quad.isRectangle() || maxAbsComponent(center) > 10.0f * glm::length(qc.v[2] - qc.v[0])) continue;
     const Vec3 n = glm::normalize(glm::cross(qc.v[1] - qc.v[0], qc.v[3] - qc.v[0]));
     for (int i = 0; i < 4000; ++i) {
       // Half the points within 1e-2 of the plane's direction, down to 1e-6.
@@ -213,13 +212,13 @@ TEST(SamplingLanes, QuadKernelAgreesWithTheScalarFormulas) {
       } else {
         ++byArea;
         const ShapeSample a = quad.sampleArea(u);
-        EXPECT_LE(glm::length(s.p - a.p), 1e-6f * (size + maxComponent(glm::abs(center)))) << where;
+        EXPECT_LE(glm::length(s.p - a.p), 1e-6f * (size + maxAbsComponent(center))) << where;
         // d^2 / cos: the sampled point's rounding (a few ulps of the coordinates) relative to
         // the distance, and the cosine's cancellation (eps / cos) bound the two evaluations' gap.
         const Vec3 toLight = a.p - ref;
         const float dist = glm::length(toLight);
         const float cosLight = std::abs(glm::dot(a.n, toLight)) / dist;
-        const float pointError = 4.0f * 0x1p-24f * (maxComponent(glm::abs(center)) + size) / dist;
+        const float pointError = 4.0f * 0x1p-24f * (maxAbsComponent(center) + size) / dist;
         const float tolerance = 1e-5f + pointError * (4.0f + 2.0f / cosLight) + 1e-6f / cosLight;
         EXPECT_NEAR(pdf, areaToSolidAnglePdf(1.0f / quad.area(), ref, a.p, a.n), tolerance * pdf) << where;
       }

@@ -270,7 +270,7 @@ std::vector<std::pair<std::string, RayMaker>> families(const Shape& shape, float
                    Vec3 d = randomDirection(rng);
                    if (rng.uniform() < 0.3f)
                      d = glm::normalize(d - glm::dot(d, s.n) * s.n * (1.0f - 1e-3f * rng.uniform()));
-                   const float err = roundingErrorBound(maxComponent(glm::abs(s.p)));
+                   const float err = roundingErrorBound(maxAbsComponent(s.p));
                    return Ray{offsetAlongNormal(s.p, s.n, err, d), d};
                  }});
   // Shadow rays to the shape's own surface, which must stop just short of it.
@@ -279,10 +279,9 @@ std::vector<std::pair<std::string, RayMaker>> families(const Shape& shape, float
                    Vec3 w = randomDirection(rng);
                    if (glm::dot(w, s.n) < 0.0f) w = -w;
                    const Vec3 ref = s.p + size * std::pow(10.0f, -3.0f + 3.5f * rng.uniform()) * w;
-                   const float err = roundingErrorBound(maxComponent(glm::abs(ref)) + size);
+                   const float err = roundingErrorBound(maxAbsComponent(ref) + size);
                    const Vec3 nFrom = glm::normalize(-w + 0.5f * randomDirection(rng));
-                   return spawnRayTo(ref, nFrom, err, s.p, s.n,
-                                     roundingErrorBound(maxComponent(glm::abs(s.p))));
+                   return spawnRayTo(ref, nFrom, err, s.p, s.n, roundingErrorBound(maxAbsComponent(s.p)));
                  }});
   // Just past the rim: points sampled on the surface, pushed outwards in the tangent plane.
   out.push_back({"at the edges", [&shape, size, center](Rng& rng) {

@@ -64,7 +64,7 @@ Ray makeRay(const Vec3& o, const Vec3& d, float tMax = kInfinity) {
 }
 
 float scaleOf(const Vec3& p) {
-  return 1.0f + maxComponent(glm::abs(p));
+  return 1.0f + maxAbsComponent(p);
 }
 
 std::string str(const Vec3& v) {
@@ -925,7 +925,7 @@ int runShadowRayTest(const Vec3& offset, uint64_t seed) {
       const Vec3 ref = s.p + dist * w;
       // The receiver faces the light: its normal within 60 degrees of the way back to s.
       const Vec3 nFrom = glm::normalize(-w + 0.5f * sampleUniformSphere(next2(rng)));
-      const float errFrom = roundingErrorBound(maxComponent(glm::abs(ref)) + sc.size);
+      const float errFrom = roundingErrorBound(maxAbsComponent(ref) + sc.size);
       LightSample ls;
       if (!light->sample(ref, next2(rng), ls) || isBlack(ls.Li) || glm::dot(nFrom, ls.wi) <= 0.0f) continue;
       // The emitter lies behind its tangent plane at s, so ref is at least this far from it; a
