@@ -45,7 +45,8 @@ class GltfImporter {
     for (const auto& [name, material] : options_.materialsByName)
       if (!usedOverrides_.count(name)) {
         std::string known;
-        for (const auto& m : model_.materials) known += (known.empty() ? "" : ", ") + ("'" + m.name + "'");
+        for (const auto& m : model_.materials)
+          known.append(known.empty() ? "'" : ", '").append(m.name).append("'");
         fail("materials",
              "no material named '" + name + "'; the file has: " + (known.empty() ? "none" : known));
       }

@@ -52,7 +52,7 @@ void JsonNode::allowKeys(std::initializer_list<std::string_view> keys) const {
     for (std::string_view k : keys) known = known || it.key() == k;
     if (known) continue;
     std::string valid;
-    for (std::string_view k : keys) valid += (valid.empty() ? "" : ", ") + std::string(k);
+    for (std::string_view k : keys) valid.append(valid.empty() ? "" : ", ").append(k);
     JsonNode(*it, path_.empty() ? it.key() : path_ + "." + it.key(), file_)
         .fail("unknown key; valid keys here are: " + valid);
   }

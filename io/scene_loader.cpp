@@ -342,7 +342,7 @@ class JsonSceneLoader {
       for (std::string_view k : keys) known = known || it.key() == k;
       if (known) continue;
       std::string valid;
-      for (std::string_view k : keys) valid += (valid.empty() ? "" : ", ") + std::string(k);
+      for (std::string_view k : keys) valid.append(valid.empty() ? "" : ", ").append(k);
       s.at(it.key()).fail("unknown key; valid keys for this shape are: " + valid);
     }
   }
