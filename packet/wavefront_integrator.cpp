@@ -85,10 +85,13 @@ void groupByGeometry(Wave& wave, size_t active, size_t geometries) {
 }
 
 // Samples every query's light, one Light::sampleLanes call per run of queries of the same light.
-void sampleLights(Wave& wave, size_t queries) {
-  // Queries are made in vertex order, so with one light (or lights met in order) they are sorted.
+void sampleLights(Wave& wave, size_t queries, size_t lights) {
+  // Sorted by light, the runs fill the lanes of the lights' kernels. Queries are made in vertex
+  // order, so with one light (or lights met in order) they are sorted already; with more lights
+  // than a wave has vectors of queries, runs would stay short, and sorting would cost more than
+  // it saves (2.5% of a render with 10,000 emitters).
   const auto keys = wave.queryKey.begin(), keysEnd = keys + ptrdiff_t(queries);
-  if (!std::is_sorted(keys, keysEnd)) std::sort(keys, keysEnd);
+  if (lights <= Wave::kSize / 16 && !std::is_sorted(keys, keysEnd)) std::sort(keys, keysEnd);
   for (size_t q = 0; q < queries; ++q) {
     const size_t v = wave.queryKey[q] & 0xffffu;
     wave.queryOf[v] = int16_t(q);
@@ -188,7 +191,7 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
         if (PathIntegrator::pickLightWith(scene, wave.drawn1D[j], wave.drawn2D[j], wave.picks[v]))
           wave.queryKey[queries++] = uint64_t(wave.picks[v].light->samplerIndex) << 16 | v;
       }
-      sampleLights(wave, queries);
+      sampleLights(wave, queries, scene.lightSampler().size());
 
       wave.shadows.clear();
       size_t next = 0;

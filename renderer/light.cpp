@@ -104,26 +104,27 @@ TriangleLight::TriangleLight(const TriangleMesh* mesh, uint32_t prim, const Colo
       radiance_(radiance),
       texture_(texture),
       twoSided_(twoSided),
-      pError_(mesh->pointError(prim)) {}
+      pError_(mesh->pointError(prim)),
+      area_(mesh->triangleArea(prim)) {}
 
 // The spherical triangle of `prim` seen from ref, when light sampling should use it.
-static std::optional<SphericalTriangle> sphericalTriangle(const TriangleMesh& mesh, uint32_t prim,
+static std::optional<SphericalTriangle> sphericalTriangle(const TriangleMesh& mesh, uint32_t prim, float area,
                                                           const Vec3& ref) {
   const glm::uvec3& idx = mesh.indices[prim];
   return sphericalTriangleForSampling(ref, mesh.positions[idx.x], mesh.positions[idx.y],
-                                      mesh.positions[idx.z], mesh.triangleArea(prim));
+                                      mesh.positions[idx.z], area);
 }
 
 float TriangleLight::pdf(const Vec3& ref, const Vec3& p, const Vec3& n) const {
-  if (const auto st = sphericalTriangle(*mesh_, prim_, ref)) return float(1.0 / st->solidAngle());
-  return areaToSolidAnglePdf(1.0f / mesh_->triangleArea(prim_), ref, p, n);
+  if (const auto st = sphericalTriangle(*mesh_, prim_, area_, ref)) return float(1.0 / st->solidAngle());
+  return areaToSolidAnglePdf(1.0f / area_, ref, p, n);
 }
 
 bool TriangleLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
   // Barycentrics (b1, b2) of vertices 1 and 2: where a direction uniform in the solid angle meets
   // the triangle, or a point uniform by area.
   Vec2 b;
-  const std::optional<SphericalTriangle> st = sphericalTriangle(*mesh_, prim_, ref);
+  const std::optional<SphericalTriangle> st = sphericalTriangle(*mesh_, prim_, area_, ref);
   if (st) {
     const glm::uvec3& idx = mesh_->indices[prim_];
     b = barycentricsAlong(mesh_->positions[idx.x], mesh_->positions[idx.y], mesh_->positions[idx.z], ref,
@@ -141,8 +142,7 @@ bool TriangleLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
   out.p = p;
   out.n = surface.ng;
   out.pError = pError_;
-  out.pdf = st ? float(1.0 / st->solidAngle())
-               : areaToSolidAnglePdf(1.0f / mesh_->triangleArea(prim_), ref, p, surface.ng);
+  out.pdf = st ? float(1.0 / st->solidAngle()) : areaToSolidAnglePdf(1.0f / area_, ref, p, surface.ng);
   out.delta = false;
   out.Li = twoSided_ || glm::dot(-out.wi, surface.ng) > 0.0f ? radiance_ : Color(0.0f);
   if (texture_) out.Li *= texture_->eval(surface.uv);

@@ -135,7 +135,7 @@ class TriangleLight final : public Light {
   // With a texture, its mean over the whole image stands in for the mean over this triangle: power
   // only steers which light is sampled, so an estimate costs variance, never bias.
   Color power(float) const override {
-    return (twoSided_ ? 2.0f : 1.0f) * kPi * mesh_->triangleArea(prim_) * radiance_ *
+    return (twoSided_ ? 2.0f : 1.0f) * kPi * area_ * radiance_ *
            (texture_ ? texture_->average() : Color(1.0f));
   }
 
@@ -146,6 +146,7 @@ class TriangleLight final : public Light {
   const Texture* texture_;
   bool twoSided_;
   float pError_;  // rounding-error bound of the triangle's sampled points
+  float area_;
 };
 
 // Radiance arriving from infinitely far away: a constant colour, or an equirectangular map

@@ -16,19 +16,13 @@ LightSampler::LightSampler(const std::vector<Light*>& lights, float sceneRadius)
     weights.push_back(w);
     total += w;
   }
-  double running = 0.0;
-  for (double w : weights) {
-    running += w;
-    cdf_.push_back(float(running / total));
-    pmf_.push_back(float(w / total));
-  }
-  if (!cdf_.empty()) cdf_.back() = 1.0f;
+  for (double w : weights) pmf_.push_back(float(w / total));
+  if (!weights.empty()) choice_ = AliasTable(weights);
 }
 
 const Light* LightSampler::sample(float u, float& pmf) const {
   if (lights_.empty()) return nullptr;
-  const auto it = std::upper_bound(cdf_.begin(), cdf_.end(), u);
-  const size_t i = std::min(size_t(it - cdf_.begin()), lights_.size() - 1);
+  const size_t i = choice_.sample(u);
   pmf = pmf_[i];
   return lights_[i];
 }

@@ -1,8 +1,9 @@
 // Chooses one light per shading point with probability proportional to its emitted power
-// (luminance of Light::power), by binary search over the cumulative distribution. O(log n) per
-// sample and no allocation, so a thousand emitters cost a few extra comparisons, not a slowdown.
+// (luminance of Light::power), from an alias table (core/alias_table.h): O(1) per sample and no
+// allocation, so ten thousand emitters cost what one does.
 #pragma once
 
+#include "core/alias_table.h"
 #include "renderer/light.h"
 
 #include <vector>
@@ -16,6 +17,7 @@ class LightSampler {
   LightSampler(const std::vector<Light*>& lights, float sceneRadius);
 
   bool empty() const { return lights_.empty(); }
+  size_t size() const { return lights_.size(); }
   // Picks a light with u in [0, 1); returns nullptr when there is none.
   const Light* sample(float u, float& pmf) const;
   float pmf(const Light* light) const;
@@ -25,7 +27,7 @@ class LightSampler {
  private:
   size_t deltaLights_ = 0;
   std::vector<const Light*> lights_;
-  std::vector<float> cdf_;  // cdf_[i] = P(index <= i); cdf_.back() == 1
+  AliasTable choice_;
   std::vector<float> pmf_;
 };
 

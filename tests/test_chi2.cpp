@@ -59,6 +59,9 @@
 #include "accel/sphere.h"
 #include "accel/triangle.h"
 #include "accel/triangle_mesh.h"
+#include "core/alias_table.h"
+#include "core/rng.h"
+#include "core/sampling.h"
 #include "materials/gltf_pbr.h"
 #include "materials/lambertian.h"
 #include "materials/mixed.h"
@@ -66,8 +69,6 @@
 #include "materials/texture.h"
 #include "renderer/light.h"
 #include "renderer/light_sampler.h"
-#include "core/rng.h"
-#include "core/sampling.h"
 #include "test_fixtures.h"
 
 #include <gtest/gtest.h>
@@ -94,7 +95,7 @@ namespace {
 // Parameters of the test as a whole.
 
 constexpr double kAlpha = 0.01;     // family-wise significance level over every case in the file
-constexpr int kNumCases = 65;       // m for the Sidak correction: must equal allCases().size()
+constexpr int kNumCases = 66;       // m for the Sidak correction: must equal allCases().size()
 constexpr long kSamples = 1000000;  // samples per case
 constexpr double kMinExpected = 5.0;
 // Absolute error allowed on integrals of the pdf over the sphere: the midpoint rule on the
@@ -714,6 +715,32 @@ void lightSamplerIndexCase(uint64_t seed) {
   judge(r, false);
 }
 
+// The alias table behind the LightSampler, over many outcomes whose weights span five orders
+// of magnitude, some of them zero: what a scene of thousands of emitters of mixed sizes gives it.
+void aliasTableCase(uint64_t seed) {
+  constexpr size_t kOutcomes = 2000;
+  std::vector<double> weights(kOutcomes);
+  for (size_t i = 0; i < kOutcomes; ++i)
+    weights[i] = i % 11 == 0 ? 0.0 : std::exp(-double(i % 53) / 4.5) * double(1 + i % 3);
+  const double total = std::accumulate(weights.begin(), weights.end(), 0.0);
+  const AliasTable table(weights);
+  ASSERT_EQ(table.size(), kOutcomes);
+  std::vector<double> observed(kOutcomes, 0.0), expected(kOutcomes);
+  for (size_t i = 0; i < kOutcomes; ++i) expected[i] = weights[i] / total * double(kSamples);
+  Rng rng(seed, 0xa11a5);
+  for (long k = 0; k < kSamples; ++k) {
+    const size_t i = table.sample(rng.uniform());
+    ASSERT_LT(i, kOutcomes);
+    observed[i] += 1.0;
+  }
+  double zeroChosen = 0.0;
+  for (size_t i = 0; i < kOutcomes; i += 11) zeroChosen += observed[i];
+  EXPECT_EQ(zeroChosen, 0.0) << "an outcome of weight 0 was chosen";
+  const Chi2Outcome r = chi2Test(observed, expected, [](size_t i) { return "outcome " + std::to_string(i); });
+  report(currentTestName(), r, 1.0, 1.0);
+  judge(r, false);
+}
+
 // Next-event estimation as the integrator does it: choose a light, then sample it. Directions
 // have density sum_i pmf_i pdf_i(w) (the point light contributes no density but takes its
 // share of the samples, which then count as "failed" in the sense of carrying no density).
@@ -958,6 +985,7 @@ const std::vector<Chi2Case>& allCases() {
     add("TriangleLight_directions", triangleLightCase);
     add("TriangleLight_directions_near", triangleLightNearCase);
     add("AreaLightQuad_directions", quadLightCase);
+    add("AliasTable_manyOutcomes", aliasTableCase);
     add("LightSampler_index_by_power", lightSamplerIndexCase);
     add("LightSampler_nee_mixture", lightSamplerMixtureCase);
 

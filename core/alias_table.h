@@ -1,0 +1,42 @@
+// Walker's alias method with Vose's linear-time construction (Vose 1991, "A Linear Algorithm for
+// Generating Random Numbers with a Given Distribution", IEEE TSE 17(9); PBRT4 section A.1): a
+// discrete distribution over n outcomes sampled in O(1) with one uniform number, where inverting
+// the cumulative sum costs a binary search, log2(n) dependent cache misses for a scene of
+// thousands of emitters.
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace ember {
+
+class AliasTable {
+ public:
+  AliasTable() = default;
+  // Outcome i gets probability weights[i] / sum(weights); the weights must be finite and >= 0
+  // with a positive sum.
+  explicit AliasTable(const std::vector<double>& weights);
+
+  size_t size() const { return bins_.size(); }
+  // The outcome for u in [0, 1): bin floor(u n) keeps its own outcome when the rest of u n is
+  // below the bin's threshold, and otherwise gives its alias.
+  // (In double, where u n is exact for any u with 24 significant bits and n < 2^29: in float the
+  // rest would lose a bit for every bit of n.)
+  size_t sample(float u) const {
+    const double scaled = double(u) * double(bins_.size());
+    const size_t bin = std::min(size_t(scaled), bins_.size() - 1);
+    const Bin& b = bins_[bin];
+    return scaled - double(bin) < double(b.threshold) ? bin : b.alias;
+  }
+
+ private:
+  struct Bin {
+    float threshold = 1.0f;  // the share of the bin that is its own outcome
+    uint32_t alias = 0;
+  };
+  std::vector<Bin> bins_;
+};
+
+}  // namespace ember
