@@ -32,8 +32,11 @@ struct RawHit {
 // paths they belong to give non-finite samples, which the film drops.
 inline bool traceable(const Ray& ray) {
   constexpr float kLarge = 1.844e18f;
-  const float m = std::max(maxAbsComponent(ray.origin), maxAbsComponent(ray.dir));
-  return m <= kLarge && !std::isnan(ray.tMax);
+  // Every component compared on its own: std::max drops a NaN in all but its first argument, and
+  // a NaN compares false, so it is untraceable wherever it is.
+  const glm::bvec3 originOk = glm::lessThanEqual(absolute(ray.origin), Vec3(kLarge));
+  const glm::bvec3 dirOk = glm::lessThanEqual(absolute(ray.dir), Vec3(kLarge));
+  return glm::all(originOk) && glm::all(dirOk) && !std::isnan(ray.tMax);
 }
 
 class EmbreeAccel {

@@ -148,7 +148,8 @@ int run(int argc, char** argv) {
       rtcOccluded16(valid, rtc, &ctx, &r);
     }
   });
-  // What the wavefront integrator does (packet/ray_batch.h): batches of 256 rays, copied in,
+  // What the wavefront integrator does (packet/ray_batch.h): batches of rays (256 here; the
+  // integrator's waves are 1,024, which changes nothing for packets, traced one by one), copied in,
   // traced as 16 packets or as one stream, hits read back.
   auto batchRow = [&](const char* name, BatchTraversal traversal, bool shadow) {
     row(name, [&, traversal, shadow](size_t lo, size_t hi) {

@@ -1,15 +1,20 @@
 #include "core/alias_table.h"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 namespace ember {
 
 AliasTable::AliasTable(const std::vector<double>& weights) : bins_(weights.size()) {
   double total = 0.0;
-  for (double w : weights) total += w;
-  if (weights.empty() || !(total > 0.0))
-    throw std::invalid_argument("AliasTable needs a positive total weight");
+  for (double w : weights) {
+    if (!(w >= 0.0) || !std::isfinite(w))
+      throw std::invalid_argument("AliasTable weights must be finite and >= 0");
+    total += w;
+  }
+  if (weights.empty() || !(total > 0.0) || !std::isfinite(total))
+    throw std::invalid_argument("AliasTable needs a positive, finite total weight");
   // Each bin holds 1/n of the probability: outcomes below that ("small") are topped up by one
   // above it ("large"), whose excess then becomes small or stays large.
   const double n = double(weights.size());

@@ -15,8 +15,8 @@ namespace ember {
 class AliasTable {
  public:
   AliasTable() = default;
-  // Outcome i gets probability weights[i] / sum(weights); the weights must be finite and >= 0
-  // with a positive sum.
+  // Outcome i gets probability weights[i] / sum(weights). Throws std::invalid_argument unless
+  // the weights are finite and >= 0 with a positive, finite sum.
   explicit AliasTable(const std::vector<double>& weights);
 
   size_t size() const { return bins_.size(); }
@@ -24,8 +24,10 @@ class AliasTable {
   // below the bin's threshold, and otherwise gives its alias.
   // (In double, where u n is exact for any u with 24 significant bits and n < 2^29: in float the
   // rest would lose a bit for every bit of n.)
+  // A u outside [0, 1), or NaN, still gives an outcome: below 0 it counts as 0, at 1 and above
+  // as the last bin.
   size_t sample(float u) const {
-    const double scaled = double(u) * double(bins_.size());
+    const double scaled = (u > 0.0f ? double(u) : 0.0) * double(bins_.size());
     const size_t bin = std::min(size_t(scaled), bins_.size() - 1);
     const Bin& b = bins_[bin];
     return scaled - double(bin) < double(b.threshold) ? bin : b.alias;

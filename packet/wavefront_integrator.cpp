@@ -32,7 +32,8 @@ struct Wave {
   std::array<SurfaceHit, kSize> hits;
   std::array<LightPick, kSize> picks;
   std::array<int16_t, kSize> queryOf;  // each vertex's light query, -1 if it samples no light
-  // The light queries (index q), sorted by light: each light samples its run at once.
+  // The light queries (index q), sorted by light in scenes of few lights (sampleLights): each
+  // light samples its run at once.
   std::array<uint64_t, kSize> queryKey;  // samplerIndex << 16 | vertex
   std::array<Vec3, kSize> queryRef;
   std::array<Vec2, kSize> queryU;

@@ -16,11 +16,13 @@ namespace ember {
 
 class WavefrontIntegrator final : public Integrator {
  public:
-  // Paths in flight per wave: a 16x16 tile's pixels at four sample indices. Four times the
-  // tile's pixels fill the late bounces' packets better and lengthen the runs of one shape,
-  // material and light; measured 0.90-0.96x the wall time of one sample index per wave
-  // (docs/performance.md, optimisation log).
+  // Paths in flight per wave: a 16x16 tile's pixels at four sample indices (fewer when a pass
+  // has fewer samples: --pass-spp 1 gives waves of 256). Four times the tile's pixels fill the
+  // late bounces' packets better and lengthen the runs of one shape, material and light;
+  // measured 0.90-0.96x the wall time of one sample index per wave (docs/performance.md,
+  // optimisation log). Indices into the wave are 16-bit (and packed below bit 16 in sort keys).
   static constexpr size_t kWaveSize = 1024;
+  static_assert(kWaveSize <= (1u << 15), "wave indices are uint16_t / int16_t");
   // Above this many geometries the bounce's hits are grouped by sorting their keys rather than
   // by a counting sort, whose buckets would then cost more to clear than the keys to sort.
   static constexpr size_t kMaxCountingSortBuckets = 1024;

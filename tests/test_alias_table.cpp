@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -34,9 +35,35 @@ TEST(AliasTable, OneOutcomeAndTheEndsOfTheUnitInterval) {
   EXPECT_NE(table.sample(0.0f), 0u) << "bin 0 has weight 0: it must give its alias";
 }
 
-TEST(AliasTable, RejectsWeightsWithoutAPositiveSum) {
+// Weights whose scaled shares are not exact in binary: the construction's rounding leftovers
+// must not move more than a grid step of u between outcomes.
+TEST(AliasTable, NonDyadicWeightsGetTheirShareToTheGridStep) {
+  for (const std::vector<double>& weights : {std::vector<double>(3, 1.0), std::vector<double>(10, 0.1),
+                                             std::vector<double>{0.1, 0.7, 0.2, 1e-9, 0.3}}) {
+    const AliasTable table(weights);
+    const int bits = 16;
+    const std::vector<long> counts = countsOnGrid(table, bits);
+    double total = 0.0;
+    for (double w : weights) total += w;
+    for (size_t i = 0; i < weights.size(); ++i)
+      EXPECT_NEAR(double(counts[i]), weights[i] / total * double(1l << bits), double(weights.size()))
+          << "outcome " << i << " of " << weights.size();
+  }
+}
+
+TEST(AliasTable, UOutsideTheUnitIntervalStillGivesAnOutcome) {
+  const AliasTable table({1.0, 2.0, 3.0});
+  for (float u : {-1.0f, 1.0f, 2.0f, std::nanf(""), -std::numeric_limits<float>::infinity()})
+    EXPECT_LT(table.sample(u), 3u) << u;
+}
+
+TEST(AliasTable, RejectsNegativeNonFiniteOrAllZeroWeights) {
   EXPECT_THROW(AliasTable(std::vector<double>{}), std::invalid_argument);
   EXPECT_THROW(AliasTable(std::vector<double>{0.0, 0.0}), std::invalid_argument);
+  EXPECT_THROW(AliasTable(std::vector<double>{1.0, -0.5}), std::invalid_argument);
+  EXPECT_THROW(AliasTable(std::vector<double>{1.0, std::nan("")}), std::invalid_argument);
+  EXPECT_THROW(AliasTable(std::vector<double>{1.0, std::numeric_limits<double>::infinity()}),
+               std::invalid_argument);
 }
 
 }  // namespace

@@ -698,6 +698,7 @@ void lightSamplerIndexCase(uint64_t seed) {
     EXPECT_NEAR(sampler.pmf(lights[i]), pmf[i], 1e-6 + 1e-5 * pmf[i]) << "light " << i;
   }
   EXPECT_EQ(set.darkLight.samplerIndex, -1);
+  EXPECT_EQ(sampler.size(), lights.size() - 1) << "only the zero-power light is left out";
   Rng rng(seed, 0x5eed);
   long inconsistent = 0;
   for (long k = 0; k < kSamples; ++k) {

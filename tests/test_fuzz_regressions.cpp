@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "test_paths.h"
 
 namespace ember {
@@ -29,6 +31,15 @@ TEST(FuzzRegressions, UntraceableCameraRaysMissInsteadOfAbortingEmbree) {
   EXPECT_FALSE(traceable(Ray{Vec3(2e18f, 0.0f, 0.0f), Vec3(0.0f, 0.0f, 1.0f)}));
   EXPECT_FALSE(traceable(Ray{Vec3(0.0f), Vec3(0.0f, 0.0f, 1.0f), std::nanf("")}));
   EXPECT_TRUE(traceable(Ray{Vec3(1e6f), Vec3(0.0f, 0.0f, 1.0f)}));
+  // A NaN in any component, not only the first (std::max would drop it in the others).
+  const float nan = std::nanf("");
+  for (int c = 0; c < 3; ++c) {
+    Vec3 bad(0.0f);
+    bad[c] = nan;
+    EXPECT_FALSE(traceable(Ray{bad, Vec3(0.0f, 0.0f, 1.0f)})) << "NaN in origin component " << c;
+    EXPECT_FALSE(traceable(Ray{Vec3(0.0f), Vec3(0.0f, 0.0f, 1.0f) + bad}))
+        << "NaN in direction component " << c;
+  }
 }
 
 // fuzz_scene_json: a number too large for a double made nlohmann throw out_of_range, which

@@ -175,10 +175,12 @@ TEST(Wavefront, SameImageAsScalarOnGltfMeshes) {
   if (std::filesystem::exists(duck)) expectKernelsAgree(loadSmall(duck, 32, 32), "Duck");
 }
 
-// Thread counts, tile sizes that do not divide the image, tiles larger and smaller than a wave,
-// and a sample range that does not start at 0: always the same film.
+// Thread counts, tile sizes that do not divide the image, tiles larger and smaller than a wave
+// (tile 40: 40 x 30 = 1,200 pixels, more than a wave's 1,024 paths, so one sample index spans two
+// waves), and a sample range that does not start at 0: always the same film.
 TEST(Wavefront, SameImageForAnyThreadsTilesAndSampleRange) {
-  const Scene scene = loadSmall(test::sourcePath("scenes/shapes.json"), 45, 19);
+  const Scene scene = loadSmall(test::sourcePath("scenes/shapes.json"), 45, 30);
+  static_assert(40 * 30 > WavefrontIntegrator::kWaveSize);
   const Film reference = renderWith(scene, Kernel::Scalar, RenderCase{1, 16, 5, 7});
   for (const RenderCase c : {RenderCase{1, 16, 5, 7}, RenderCase{2, 16, 5, 7}, RenderCase{2, 7, 5, 7},
                              RenderCase{2, 40, 5, 7}, RenderCase{1, 3, 5, 7}}) {
