@@ -178,6 +178,74 @@ uint32_t SphereCandidates(const RayLanes& rays, const Vec3& center, float radius
   });
 }
 
+// Sphere::intersect for every candidate lane at once, in double precision: the same operations
+// in the same order (this file is compiled with -ffp-contract=off, and IEEE division and square
+// root round exactly), so each lane's hit equals the scalar routine's bit for bit. Lanes whose
+// direction has zero length (never traced: traceable() rejects them) are left to the caller.
+using D64 = hn::CappedTag<double, RayLanes::kMaxLanes / 2>;
+using V64 = hn::Vec<D64>;
+
+HWY_INLINE V64 dot64(const V64& ax, const V64& ay, const V64& az, const V64& bx, const V64& by,
+                     const V64& bz) {
+  return hn::Add(hn::Add(hn::Mul(ax, bx), hn::Mul(ay, by)), hn::Mul(az, bz));  // glm: (x + y) + z
+}
+
+uint32_t SphereHitsKernel(const RayLanes& rays, const Vec3& center, float radius, uint32_t candidates,
+                          SphereHits& out) {
+  const D64 d;
+  const hn::Rebind<float, D64> df;
+  const unsigned step = unsigned(hn::Lanes(d));
+  const V64 cx = hn::Set(d, double(center.x)), cy = hn::Set(d, double(center.y)),
+            cz = hn::Set(d, double(center.z));
+  const V64 r2 = hn::Set(d, double(radius) * double(radius));
+  const V64 zero = hn::Zero(d), two = hn::Set(d, 2.0), four = hn::Set(d, 4.0), half = hn::Set(d, -0.5),
+            one = hn::Set(d, 1.0);
+  uint32_t hits = 0, unsolved = 0;
+  for (unsigned i = 0; i < rays.n; i += step) {
+    const uint8_t laneBits = uint8_t((candidates >> i) & ((1u << step) - 1u));
+    if (laneBits == 0) continue;
+    const auto live = hn::LoadMaskBits(d, &laneBits);
+    auto load = [&](const float* p) { return hn::PromoteTo(d, hn::LoadU(df, p + i)); };
+    const V64 ox = hn::Sub(load(rays.org[0]), cx), oy = hn::Sub(load(rays.org[1]), cy),
+              oz = hn::Sub(load(rays.org[2]), cz);
+    const V64 dx = load(rays.dir[0]), dy = load(rays.dir[1]), dz = load(rays.dir[2]);
+    const V64 tMin = load(rays.tnear), tMax = load(rays.tfar);
+    const V64 a = dot64(dx, dy, dz, dx, dy, dz);
+    const V64 b = hn::Mul(two, dot64(ox, oy, oz, dx, dy, dz));
+    const V64 c = hn::Sub(dot64(ox, oy, oz, ox, oy, oz), r2);
+    // solveQuadratic (accel/solve.h).
+    const auto flat = hn::Eq(a, zero);
+    const V64 discrim = hn::Sub(hn::Mul(b, b), hn::Mul(hn::Mul(four, a), c));
+    const auto real = hn::Not(hn::Lt(discrim, zero));
+    const V64 root = hn::Sqrt(discrim);
+    const V64 q = hn::Mul(half, hn::IfThenElse(hn::Lt(b, zero), hn::Sub(b, root), hn::Add(b, root)));
+    V64 t0 = hn::Div(q, a);
+    V64 t1 = hn::IfThenElse(hn::Ne(q, zero), hn::Div(c, q), t0);
+    const auto swap = hn::Gt(t0, t1);
+    const V64 lo = hn::IfThenElse(swap, t1, t0), hi = hn::IfThenElse(swap, t0, t1);
+    // The nearer root within (tMin, tMax), else the farther one.
+    const auto outside = [&](const V64& t) { return hn::Or(hn::Le(t, tMin), hn::Ge(t, tMax)); };
+    const auto loOut = outside(lo);
+    const V64 t = hn::IfThenElse(loOut, hi, lo);
+    const auto hit = hn::AndNot(flat, hn::And(live, hn::And(real, hn::Not(hn::And(loOut, outside(hi))))));
+    // The unit normal: glm::normalize(oc + t d) = v * (1 / sqrt(dot(v, v))).
+    const V64 lx = hn::Add(ox, hn::Mul(t, dx)), ly = hn::Add(oy, hn::Mul(t, dy)),
+              lz = hn::Add(oz, hn::Mul(t, dz));
+    const V64 inv = hn::Div(one, hn::Sqrt(dot64(lx, ly, lz, lx, ly, lz)));
+    hn::StoreU(hn::DemoteTo(df, t), df, out.t + i);
+    hn::StoreU(hn::DemoteTo(df, hn::Mul(lx, inv)), df, out.ng[0] + i);
+    hn::StoreU(hn::DemoteTo(df, hn::Mul(ly, inv)), df, out.ng[1] + i);
+    hn::StoreU(hn::DemoteTo(df, hn::Mul(lz, inv)), df, out.ng[2] + i);
+    uint8_t bits[8] = {};
+    hn::StoreMaskBits(d, hit, bits);
+    hits |= uint32_t(bits[0]) << i;
+    hn::StoreMaskBits(d, hn::And(live, flat), bits);
+    unsolved |= uint32_t(bits[0]) << i;
+  }
+  out.unsolved = unsolved;
+  return hits;
+}
+
 }  // namespace ember::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
@@ -186,6 +254,7 @@ namespace ember {
 
 HWY_EXPORT(TriangleLanesKernel);
 HWY_EXPORT(SphereCandidates);
+HWY_EXPORT(SphereHitsKernel);
 
 TriangleFilter TriangleFilter::of(const Vec3& v0, const Vec3& v1, const Vec3& v2, const DoublePlane& plane,
                                   bool parallelogram) {
@@ -218,6 +287,11 @@ void triangleLanes(const RayLanes& rays, const TriangleFilter& tri, TriangleLane
 
 uint32_t sphereCandidates(const RayLanes& rays, const Vec3& center, float radius) {
   return HWY_DYNAMIC_DISPATCH(SphereCandidates)(rays, center, radius);
+}
+
+uint32_t sphereHits(const RayLanes& rays, const Vec3& center, float radius, uint32_t candidates,
+                    SphereHits& out) {
+  return HWY_DYNAMIC_DISPATCH(SphereHitsKernel)(rays, center, radius, candidates, out);
 }
 
 }  // namespace ember

@@ -36,7 +36,21 @@ bool Sphere::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) co
   const glm::dvec3 local = oc + t * d;
   hit.t = float(t);
   hit.ng = Vec3(glm::normalize(local));
+  hit.uv = Vec2(0.0f);  // surfaceUv derives it from the normal
   return true;
+}
+
+void Sphere::intersectLanes(const RayLanes& rays, LaneHits& out) const {
+  SphereHits lanes;
+  out.mask = sphereHits(rays, center_, radius_, candidateLanes(rays), lanes);
+  for (uint32_t bits = out.mask; bits != 0; bits &= bits - 1) {
+    const unsigned i = unsigned(__builtin_ctz(bits));
+    out.hit[i] = LocalHit{lanes.t[i], Vec3(lanes.ng[0][i], lanes.ng[1][i], lanes.ng[2][i]), Vec2(0.0f)};
+  }
+  for (uint32_t bits = lanes.unsolved; bits != 0; bits &= bits - 1) {
+    const unsigned i = unsigned(__builtin_ctz(bits));
+    if (intersect(rays.ray(i), rays.tnear[i], rays.tfar[i], out.hit[i])) out.mask |= 1u << i;
+  }
 }
 
 SurfacePoint Sphere::projectToSurface(const Vec3& p, const LocalHit&) const {

@@ -17,6 +17,8 @@ class Sphere final : public Shape {
   uint32_t candidateLanes(const RayLanes& rays) const override {
     return sphereCandidates(rays, center_, radius_);
   }
+  // The candidates' exact tests in one double-precision kernel (sphereHits), equal to intersect().
+  void intersectLanes(const RayLanes& rays, LaneHits& out) const override;
   // Longitude from +z towards +x, latitude from +y (../shared/refs/CONVENTIONS.md).
   Vec2 surfaceUv(const LocalHit& hit) const override;
   SurfacePoint projectToSurface(const Vec3& p, const LocalHit& hit) const override;

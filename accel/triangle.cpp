@@ -152,6 +152,7 @@ Quad::Quad(const std::array<Vec3, 4>& v, const std::array<Vec2, 4>& uv)
   // A degenerate half (a quad given as a triangle, v3 = v0) has no plane of its own.
   if (!(area1_ > 0.0f)) planes_[1] = planes_[0];
   if (!(area0_ > 0.0f)) planes_[0] = planes_[1];
+  samePlanes_ = planes_[0].n == planes_[1].n && planes_[0].d == planes_[1].d;
   // An exact parallelogram (v2 = v1 + v3 - v0, which double evaluates without rounding) whose
   // halves lie in planes agreeing far below the filter's float tolerance is filtered in one test.
   const glm::dvec3 opposite = glm::dvec3(v[1]) + glm::dvec3(v[3]) - glm::dvec3(v[0]);
@@ -278,6 +279,7 @@ void Quad::intersectLanes(const RayLanes& rays, LaneHits& out) const {
 }
 
 SurfacePoint Quad::projectToSurface(const Vec3& p, const LocalHit&) const {
+  if (samePlanes_) return planes_[0].project(p);  // an axis-aligned rectangle, say
   // The diagonal v0-v2 separates the halves: v1 lies on one side of it, v3 on the other.
   const bool firstHalf = glm::dot(glm::cross(v_[2] - v_[0], p - v_[0]), normal_) <= 0.0f;
   return planes_[firstHalf ? 0 : 1].project(p);

@@ -77,6 +77,7 @@ class Quad final : public Shape {
   std::array<Vec2, 4> uv_;
   Vec3 normal_;
   DoublePlane planes_[2];       // of the halves (v0,v1,v2) and (v0,v2,v3)
+  bool samePlanes_ = false;     // the two are equal bit for bit: projecting needs no side test
   TriangleFilter filters_[2];   // of the same halves, or twice the one of the whole parallelogram
   PlaneCoordinates coords_[2];  // likewise
   bool singleFilter_ = false;

@@ -185,8 +185,7 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
         ++vertices;
       }
       // pickLight for the bounce: its 1D, then its 2D request, then the choice.
-      draw1DLanes(wave.samplerOf.data(), lightDraws, wave.drawn1D.data());
-      draw2DLanes(wave.samplerOf.data(), lightDraws, wave.drawn2D.data());
+      draw1DThen2DLanes(wave.samplerOf.data(), lightDraws, wave.drawn1D.data(), wave.drawn2D.data());
       for (size_t j = 0; j < lightDraws; ++j) {
         const size_t v = wave.lightVertex[j];
         if (PathIntegrator::pickLightWith(scene, wave.drawn1D[j], wave.drawn2D[j], wave.picks[v]))
@@ -211,8 +210,7 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
         wave.samplerOf[v] = &lane.sampler;
       }
       // PathIntegrator::drawBsdfSample for the bounce: its 2D, then its 1D request.
-      draw2DLanes(wave.samplerOf.data(), vertices, wave.bsdfU.data());
-      draw1DLanes(wave.samplerOf.data(), vertices, wave.bsdfLobe.data());
+      draw2DThen1DLanes(wave.samplerOf.data(), vertices, wave.bsdfU.data(), wave.bsdfLobe.data());
       sampleBsdfs(wave, vertices);
       wave.closest.clear();  // its hits are all read
       for (size_t v = 0; v < vertices; ++v) {

@@ -77,49 +77,84 @@ float toFloat(uint32_t x) {
   return float(x >> 8) * 0x1p-24f;
 }
 
-// Draws a request for every sampler: the Sobol ones in blocks through the kernel, the others
-// from their PCG32 streams; store(i, first, second) receives lane i's numbers.
-template <bool kTwoD, typename Store, typename Scalar>
-void drawLanes(Sampler* const* samplers, size_t n, Store store, Scalar scalar) {
-  SobolBlock block;
-  size_t lane[SobolBlock::kBlock];
-  size_t count = 0;
-  auto flush = [&] {
-    // Lanes past `count` are hashed too (vectors are whole); their inputs are kept defined.
-    std::fill(block.seed + count, block.seed + SobolBlock::kBlock, 0u);
-    std::fill(block.index + count, block.index + SobolBlock::kBlock, 0u);
-    HWY_DYNAMIC_DISPATCH(SobolLanes)(block, SobolBlock::kBlock, kTwoD);
-    for (size_t k = 0; k < count; ++k)
-      store(lane[k], toFloat(block.first[k]), kTwoD ? toFloat(block.second[k]) : 0.0f);
-    count = 0;
-  };
-  for (size_t i = 0; i < n; ++i) {
-    Sampler& s = *samplers[i];
+// Collects Sobol requests (1D or 2D) of many samplers and hashes them in blocks through the
+// kernel; requests past the Sobol dimensions are drawn at once from the sampler's PCG32 stream.
+// A sampler's Sobol values depend only on its (seed, dimension, index) and never touch that
+// stream, so deferring them to the block's flush leaves every number as the scalar order gives it.
+class SobolRequests {
+ public:
+  ~SobolRequests() { flush(); }
+
+  // The sampler's next request into x (and y for a 2D one).
+  void request(Sampler& s, bool twoD, float* x, float* y) {
     if (!s.nextIsSobol()) {
-      scalar(i, s);
-      continue;
+      if (twoD) {
+        const Vec2 v = s.get2D();
+        *x = v.x;
+        *y = v.y;
+      } else {
+        *x = s.get1D();
+      }
+      return;
     }
-    block.seed[count] = uint32_t(mix64((uint64_t(s.pixelSeed()) << 32) | s.dimension()));
-    block.index[count] = s.sampleIndex();
-    lane[count++] = i;
+    block_.seed[count_] = uint32_t(mix64((uint64_t(s.pixelSeed()) << 32) | s.dimension()));
+    block_.index[count_] = s.sampleIndex();
+    x_[count_] = x;
+    y_[count_] = twoD ? y : nullptr;
+    anyTwoD_ |= twoD;
     s.skipDimension();
-    if (count == SobolBlock::kBlock) flush();
+    if (++count_ == SobolBlock::kBlock) flush();
   }
-  if (count > 0) flush();
-}
+
+  void flush() {
+    if (count_ == 0) return;
+    // Lanes past count_ are hashed too (vectors are whole); their inputs are kept defined. A 1D
+    // request is the first number of the 2D formula with the same seed (Sampler::get1D).
+    std::fill(block_.seed + count_, block_.seed + SobolBlock::kBlock, 0u);
+    std::fill(block_.index + count_, block_.index + SobolBlock::kBlock, 0u);
+    HWY_DYNAMIC_DISPATCH(SobolLanes)(block_, SobolBlock::kBlock, anyTwoD_);
+    for (size_t k = 0; k < count_; ++k) {
+      *x_[k] = toFloat(block_.first[k]);
+      if (y_[k]) *y_[k] = toFloat(block_.second[k]);
+    }
+    count_ = 0;
+    anyTwoD_ = false;
+  }
+
+ private:
+  SobolBlock block_;
+  float* x_[SobolBlock::kBlock];
+  float* y_[SobolBlock::kBlock];
+  size_t count_ = 0;
+  bool anyTwoD_ = false;
+};
 
 }  // namespace
 
 void draw1DLanes(Sampler* const* samplers, size_t n, float* out) {
-  drawLanes<false>(
-      samplers, n, [&](size_t i, float x, float) { out[i] = x; },
-      [&](size_t i, Sampler& s) { out[i] = s.get1D(); });
+  SobolRequests requests;
+  for (size_t i = 0; i < n; ++i) requests.request(*samplers[i], false, &out[i], nullptr);
 }
 
 void draw2DLanes(Sampler* const* samplers, size_t n, Vec2* out) {
-  drawLanes<true>(
-      samplers, n, [&](size_t i, float x, float y) { out[i] = Vec2(x, y); },
-      [&](size_t i, Sampler& s) { out[i] = s.get2D(); });
+  SobolRequests requests;
+  for (size_t i = 0; i < n; ++i) requests.request(*samplers[i], true, &out[i].x, &out[i].y);
+}
+
+void draw1DThen2DLanes(Sampler* const* samplers, size_t n, float* first, Vec2* second) {
+  SobolRequests requests;
+  for (size_t i = 0; i < n; ++i) {
+    requests.request(*samplers[i], false, &first[i], nullptr);
+    requests.request(*samplers[i], true, &second[i].x, &second[i].y);
+  }
+}
+
+void draw2DThen1DLanes(Sampler* const* samplers, size_t n, Vec2* first, float* second) {
+  SobolRequests requests;
+  for (size_t i = 0; i < n; ++i) {
+    requests.request(*samplers[i], true, &first[i].x, &first[i].y);
+    requests.request(*samplers[i], false, &second[i], nullptr);
+  }
 }
 
 }  // namespace ember

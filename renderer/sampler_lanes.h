@@ -27,5 +27,9 @@ struct SobolBlock {
 void draw1DLanes(Sampler* const* samplers, size_t n, float* out);
 // out[i] = samplers[i]->get2D() for i < n.
 void draw2DLanes(Sampler* const* samplers, size_t n, Vec2* out);
+// Two requests of each sampler in one pass (a light choice's, a BSDF sample's): first[i] =
+// samplers[i]->get1D(), then second[i] = samplers[i]->get2D(); and the other way round.
+void draw1DThen2DLanes(Sampler* const* samplers, size_t n, float* first, Vec2* second);
+void draw2DThen1DLanes(Sampler* const* samplers, size_t n, Vec2* first, float* second);
 
 }  // namespace ember

@@ -360,9 +360,28 @@ TEST(SamplingLanes, SamplerLanesEqualTheScalarSampler) {
     }
     std::vector<Sampler*> pointers;
     for (Sampler& s : lanes) pointers.push_back(&s);
-    for (int request = 0; request < 12; ++request) {
+    for (int request = 0; request < 16; ++request) {
       const size_t n = request % 4 == 3 ? 17 : lanes.size();  // some requests for a prefix only
-      if (request % 2 == 0) {
+      if (request % 8 == 5 || request % 8 == 6) {
+        // Two requests per sampler in one pass, in either order.
+        std::vector<float> one(n);
+        std::vector<Vec2> two(n);
+        const bool oneFirst = request % 8 == 5;
+        if (oneFirst) {
+          draw1DThen2DLanes(pointers.data(), n, one.data(), two.data());
+        } else {
+          draw2DThen1DLanes(pointers.data(), n, two.data(), one.data());
+        }
+        for (size_t i = 0; i < n; ++i) {
+          float expectedOne = 0.0f;
+          if (oneFirst) expectedOne = reference[i].get1D();
+          const Vec2 expectedTwo = reference[i].get2D();
+          if (!oneFirst) expectedOne = reference[i].get1D();
+          EXPECT_EQ(expectedOne, one[i]) << "request " << request << " lane " << i;
+          EXPECT_EQ(expectedTwo.x, two[i].x) << "request " << request << " lane " << i;
+          EXPECT_EQ(expectedTwo.y, two[i].y) << "request " << request << " lane " << i;
+        }
+      } else if (request % 2 == 0) {
         std::vector<Vec2> out(n);
         draw2DLanes(pointers.data(), n, out.data());
         for (size_t i = 0; i < n; ++i) {
