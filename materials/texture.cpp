@@ -1,6 +1,40 @@
 #include "materials/texture.h"
 
+#include <cstring>
+
 namespace ember {
+
+namespace {
+
+// The distinct values of one channel, by bit pattern, in an open-addressing table of twice the
+// palette's size: index(bits) gives the value's palette slot, or -1 once a 257th value appears.
+class ChannelPalette {
+ public:
+  int index(float value, std::array<float, 256>& palette) {
+    uint32_t bits;
+    std::memcpy(&bits, &value, sizeof bits);
+    for (uint32_t slot = (bits * 0x9e3779b1u) >> (32 - kLog2Slots);; slot = (slot + 1) & (kSlots - 1)) {
+      if (used_[slot] && keys_[slot] == bits) return index_[slot];
+      if (used_[slot]) continue;
+      if (size_ == 256) return -1;
+      used_[slot] = true;
+      keys_[slot] = bits;
+      index_[slot] = uint8_t(size_);
+      palette[size_] = value;
+      return size_++;
+    }
+  }
+
+ private:
+  static constexpr int kLog2Slots = 9;
+  static constexpr uint32_t kSlots = 1u << kLog2Slots;
+  std::array<uint32_t, kSlots> keys_{};
+  std::array<uint8_t, kSlots> index_{};
+  std::array<bool, kSlots> used_{};
+  int size_ = 0;
+};
+
+}  // namespace
 
 ImageTexture::ImageTexture(int width, int height, std::vector<Color> texels, TextureFilter filter,
                            TextureWrap wrapS, TextureWrap wrapT, const Color& scale)
@@ -17,6 +51,19 @@ ImageTexture::ImageTexture(int width, int height, std::vector<Color> texels, Tex
     sum += c * scale_;
   }
   if (!texels_.empty()) average_ = sum / float(texels_.size());
+
+  ChannelPalette channels[3];
+  std::vector<uint8_t> indices(3 * texels_.size());
+  for (size_t i = 0; i < texels_.size(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      const int k = channels[c].index(texels_[i][c], palette_[size_t(c)]);
+      if (k < 0) return;  // more than 256 values: the floats stay
+      indices[3 * i + size_t(c)] = uint8_t(k);
+    }
+  }
+  indices_ = std::move(indices);
+  paletted_ = true;
+  std::vector<Color>().swap(texels_);
 }
 
 static int wrapIndex(int i, int n, TextureWrap wrap) {
@@ -37,7 +84,10 @@ static int wrapIndex(int i, int n, TextureWrap wrap) {
 Color ImageTexture::texel(int x, int y) const {
   x = wrapIndex(x, width_, wrapS_);
   y = wrapIndex(y, height_, wrapT_);
-  return texels_[size_t(y) * size_t(width_) + size_t(x)];
+  const size_t i = size_t(y) * size_t(width_) + size_t(x);
+  if (!paletted_) return texels_[i];
+  const uint8_t* k = &indices_[3 * i];
+  return {palette_[0][k[0]], palette_[1][k[1]], palette_[2][k[2]]};
 }
 
 Color ImageTexture::eval(Vec2 uv) const {

@@ -5,6 +5,8 @@
 
 #include "core/math.h"
 
+#include <array>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -51,12 +53,21 @@ class ImageTexture final : public Texture {
   Color average() const override { return average_; }
   int width() const { return width_; }
   int height() const { return height_; }
+  // Whether the texels are kept as palette indices (see below).
+  bool paletted() const { return paletted_; }
 
  private:
   Color texel(int x, int y) const;
 
   int width_, height_;
+  // Texels of at most 256 distinct values per channel (every 8-bit image, whatever its encoding)
+  // are kept as one byte per channel into a per-channel palette of their exact floats: a quarter of
+  // the memory and of the cache misses of incoherent lookups, and the same values bit for bit.
+  // Other images (HDR, 16-bit) keep their floats in texels_.
   std::vector<Color> texels_;
+  std::vector<uint8_t> indices_;  // 3 per texel, when paletted
+  std::array<std::array<float, 256>, 3> palette_{};
+  bool paletted_ = false;
   TextureFilter filter_;
   TextureWrap wrapS_, wrapT_;
   Color scale_;

@@ -1,0 +1,86 @@
+// ImageTexture keeps 8-bit images (at most 256 distinct values per channel) as palette indices
+// and everything else as floats; either way a lookup must return the texel's value bit for bit.
+#include "materials/texture.h"
+
+#include "core/rng.h"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <vector>
+
+namespace ember {
+namespace {
+
+uint32_t bitsOf(float x) {
+  uint32_t b;
+  std::memcpy(&b, &x, sizeof b);
+  return b;
+}
+
+// Every texel read back at its centre, nearest filter, compared bit for bit.
+void expectExactTexels(const std::vector<Color>& texels, int width, int height, bool paletted) {
+  const ImageTexture texture(width, height, texels, TextureFilter::Nearest, TextureWrap::Clamp);
+  ASSERT_EQ(texture.paletted(), paletted);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const Color got =
+          texture.eval(Vec2((float(x) + 0.5f) / float(width), (float(y) + 0.5f) / float(height)));
+      const Color& want = texels[size_t(y) * size_t(width) + size_t(x)];
+      for (int c = 0; c < 3; ++c)
+        ASSERT_EQ(bitsOf(got[c]), bitsOf(want[c])) << "texel (" << x << ", " << y << ") channel " << c;
+    }
+  }
+}
+
+TEST(ImageTexture, EightBitImagesReadBackExactly) {
+  // An sRGB-decoded 8-bit image, each channel in its own order: 256 values per channel, the
+  // palette's limit, counting both zeros (-0 and +0 are different bit patterns, so different
+  // palette entries).
+  const int w = 64, h = 32;
+  std::vector<Color> texels(size_t(w * h));
+  for (size_t i = 0; i < texels.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      texels[i][c] = srgbToLinear(float(1 + (i * size_t(2 * c + 1) + size_t(c)) % 254) / 255.0f);
+  texels[7] = Color(-0.0f, 0.0f, -0.0f);
+  texels[9] = Color(0.0f, -0.0f, 0.0f);
+  expectExactTexels(texels, w, h, true);
+}
+
+TEST(ImageTexture, HighDynamicRangeImagesReadBackExactly) {
+  // 257 distinct values in one channel: beyond a palette, kept as floats.
+  const int w = 257, h = 3;
+  std::vector<Color> texels(size_t(w * h), Color(0.25f));
+  for (int x = 0; x < w; ++x) texels[size_t(x)].g = 1.0f + float(x) * 0.37f;
+  expectExactTexels(texels, w, h, false);
+  // Random floats everywhere.
+  Rng rng(9, 2);
+  std::vector<Color> noise(size_t(40 * 40));
+  for (Color& c : noise) c = Color(rng.uniform(), 100.0f * rng.uniform(), rng.uniform() - 0.5f);
+  expectExactTexels(noise, 40, 40, false);
+}
+
+TEST(ImageTexture, BilinearLookupsAgreeBetweenPaletteAndFloats) {
+  // The same 8-bit image once as it is (paletted) and once with one extra value far away (which
+  // forces floats for the whole image): every lookup away from that texel must be equal.
+  const int w = 300, h = 2;
+  std::vector<Color> small(size_t(w * h));
+  for (size_t i = 0; i < small.size(); ++i)
+    small[i] = Color(float(i % 256) / 255.0f, float((i * 7) % 256) / 255.0f, 0.5f);
+  std::vector<Color> wide = small;
+  for (int k = 0; k < 2; ++k) wide[size_t(k * w + w - 1)].r = 3.0f + float(k);  // 257th value of red
+  const ImageTexture a(w, h, small, TextureFilter::Bilinear, TextureWrap::Repeat);
+  const ImageTexture b(w, h, wide, TextureFilter::Bilinear, TextureWrap::Repeat);
+  ASSERT_TRUE(a.paletted());
+  ASSERT_FALSE(b.paletted());
+  Rng rng(3, 3);
+  for (int i = 0; i < 2000; ++i) {
+    // Clear of the last column, which a lookup near u = 0 also reads when it wraps.
+    const Vec2 uv(0.05f + 0.85f * rng.uniform(), 4.0f * rng.uniform() - 2.0f);
+    const Color ca = a.eval(uv), cb = b.eval(uv);
+    for (int c = 0; c < 3; ++c) ASSERT_EQ(bitsOf(ca[c]), bitsOf(cb[c])) << "uv " << uv.x << " " << uv.y;
+  }
+}
+
+}  // namespace
+}  // namespace ember
