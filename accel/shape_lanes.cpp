@@ -246,6 +246,49 @@ uint32_t SphereHitsKernel(const RayLanes& rays, const Vec3& center, float radius
   return hits;
 }
 
+// DoublePlane::crossedWithin (the form with an anchor) and PlaneCoordinates::at for the lanes in
+// `lanes`, in double precision with the scalar routines' operations in their order, so the
+// results equal theirs bit for bit: t = n.(anchor - o) / n.dir, a hit where n.dir != 0 and
+// tMin < t < tMax, and with `needsCoords` the plane coordinates of o + t dir.
+uint32_t PlaneCrossingsKernel(const RayLanes& rays, const DoublePlane& plane, const PlaneCoordinates& coords,
+                              uint32_t lanes, bool needsCoords, PlaneCrossings& out) {
+  const D64 d;
+  const hn::Rebind<float, D64> df;
+  const unsigned step = unsigned(hn::Lanes(d));
+  const V64 nx = hn::Set(d, plane.n.x), ny = hn::Set(d, plane.n.y), nz = hn::Set(d, plane.n.z);
+  const V64 ax = hn::Set(d, coords.v0.x), ay = hn::Set(d, coords.v0.y), az = hn::Set(d, coords.v0.z);
+  const V64 zero = hn::Zero(d);
+  uint32_t hits = 0;
+  for (unsigned i = 0; i < rays.n; i += step) {
+    const uint8_t laneBits = uint8_t((lanes >> i) & ((1u << step) - 1u));
+    if (laneBits == 0) continue;
+    const auto live = hn::LoadMaskBits(d, &laneBits);
+    auto load = [&](const float* p) { return hn::PromoteTo(d, hn::LoadU(df, p + i)); };
+    const V64 ox = load(rays.org[0]), oy = load(rays.org[1]), oz = load(rays.org[2]);
+    const V64 dx = load(rays.dir[0]), dy = load(rays.dir[1]), dz = load(rays.dir[2]);
+    const V64 denom = dot64(nx, ny, nz, dx, dy, dz);
+    const V64 t = hn::Div(dot64(nx, ny, nz, hn::Sub(ax, ox), hn::Sub(ay, oy), hn::Sub(az, oz)), denom);
+    const auto within = hn::And(hn::Gt(t, load(rays.tnear)), hn::Lt(t, load(rays.tfar)));
+    const auto hit = hn::And(live, hn::AndNot(hn::Eq(denom, zero), within));
+    hn::StoreU(hn::DemoteTo(df, t), df, out.t + i);
+    if (needsCoords) {
+      // PlaneCoordinates::at(o + t dir): rel = p - v0, b_k = rel.g_k.
+      const V64 rx = hn::Sub(hn::Add(ox, hn::Mul(t, dx)), ax), ry = hn::Sub(hn::Add(oy, hn::Mul(t, dy)), ay),
+                rz = hn::Sub(hn::Add(oz, hn::Mul(t, dz)), az);
+      const V64 b1 =
+          dot64(rx, ry, rz, hn::Set(d, coords.g1.x), hn::Set(d, coords.g1.y), hn::Set(d, coords.g1.z));
+      const V64 b2 =
+          dot64(rx, ry, rz, hn::Set(d, coords.g2.x), hn::Set(d, coords.g2.y), hn::Set(d, coords.g2.z));
+      hn::StoreU(hn::DemoteTo(df, b1), df, out.b[0] + i);
+      hn::StoreU(hn::DemoteTo(df, b2), df, out.b[1] + i);
+    }
+    uint8_t bits[8] = {};
+    hn::StoreMaskBits(d, hit, bits);
+    hits |= uint32_t(bits[0]) << i;
+  }
+  return hits;
+}
+
 }  // namespace ember::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
@@ -255,6 +298,7 @@ namespace ember {
 HWY_EXPORT(TriangleLanesKernel);
 HWY_EXPORT(SphereCandidates);
 HWY_EXPORT(SphereHitsKernel);
+HWY_EXPORT(PlaneCrossingsKernel);
 
 TriangleFilter TriangleFilter::of(const Vec3& v0, const Vec3& v1, const Vec3& v2, const DoublePlane& plane,
                                   bool parallelogram) {
@@ -292,6 +336,11 @@ uint32_t sphereCandidates(const RayLanes& rays, const Vec3& center, float radius
 uint32_t sphereHits(const RayLanes& rays, const Vec3& center, float radius, uint32_t candidates,
                     SphereHits& out) {
   return HWY_DYNAMIC_DISPATCH(SphereHitsKernel)(rays, center, radius, candidates, out);
+}
+
+uint32_t planeCrossings(const RayLanes& rays, const DoublePlane& plane, const PlaneCoordinates& coords,
+                        uint32_t lanes, bool needsCoords, PlaneCrossings& out) {
+  return HWY_DYNAMIC_DISPATCH(PlaneCrossingsKernel)(rays, plane, coords, lanes, needsCoords, out);
 }
 
 }  // namespace ember

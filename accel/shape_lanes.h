@@ -24,6 +24,7 @@
 namespace ember {
 
 struct DoublePlane;
+struct PlaneCoordinates;
 
 // Up to kMaxLanes rays in Embree's RTCRayN layout: lane i of each array.
 struct RayLanes {
@@ -88,5 +89,17 @@ struct SphereHits {
 };
 uint32_t sphereHits(const RayLanes& rays, const Vec3& center, float radius, uint32_t candidates,
                     SphereHits& out);
+
+// The settled hits of a flat shape (the lanes its kernel found certainly inside), all at once in
+// double precision and equal bit for bit to DoublePlane::crossedWithin(ray, tnear, tfar,
+// coords.v0, t) and, with `needsCoords`, to coords.at(o + t dir): bit i of the result set when
+// lane i of `lanes` crosses the plane within its interval, with float(t) and the coordinates in
+// lane i of `out`.
+struct PlaneCrossings {
+  alignas(64) float t[RayLanes::kMaxLanes];
+  alignas(64) float b[2][RayLanes::kMaxLanes];
+};
+uint32_t planeCrossings(const RayLanes& rays, const DoublePlane& plane, const PlaneCoordinates& coords,
+                        uint32_t lanes, bool needsCoords, PlaneCrossings& out);
 
 }  // namespace ember

@@ -76,26 +76,19 @@ uint32_t Triangle::candidateLanes(const RayLanes& rays) const {
 void Triangle::intersectLanes(const RayLanes& rays, LaneHits& out) const {
   TriangleLanes lanes;
   triangleLanes(rays, filter_, lanes);
-  out.mask = 0;
-  for (uint32_t bits = lanes.candidates; bits != 0; bits &= bits - 1) {
+  // Certainly inside: the hit is where the ray crosses the plane, and its barycentrics are the
+  // crossing point's plane coordinates, both in double as Moller-Trumbore has them.
+  PlaneCrossings crossings;
+  out.mask = planeCrossings(rays, plane_, coords_, lanes.inside, rays.needsUv, crossings);
+  for (uint32_t bits = out.mask; bits != 0; bits &= bits - 1) {
     const unsigned i = unsigned(__builtin_ctz(bits));
-    const Ray ray = rays.ray(i);
-    LocalHit& h = out.hit[i];
-    double t;
-    if (!((lanes.inside >> i) & 1u)) {
-      if (intersect(ray, rays.tnear[i], ray.tMax, h)) out.mask |= 1u << i;
-    } else if (plane_.crossedWithin(ray, rays.tnear[i], ray.tMax, coords_.v0, t)) {
-      // Certainly inside: the hit is where the ray crosses the plane, and its barycentrics are
-      // the crossing point's plane coordinates, both in double as Moller-Trumbore has them.
-      h.t = float(t);
-      h.ng = normal_;
-      h.uv = Vec2(0.0f);
-      if (rays.needsUv) {
-        const Vec2 b = coords_.at(glm::dvec3(ray.origin) + t * glm::dvec3(ray.dir));
-        h.uv = uvAt(uv_[0], uv_[1], uv_[2], b.x, b.y);
-      }
-      out.mask |= 1u << i;
-    }
+    const Vec2 uv =
+        rays.needsUv ? uvAt(uv_[0], uv_[1], uv_[2], crossings.b[0][i], crossings.b[1][i]) : Vec2(0.0f);
+    out.hit[i] = LocalHit{crossings.t[i], normal_, uv};
+  }
+  for (uint32_t bits = lanes.candidates & ~lanes.inside; bits != 0; bits &= bits - 1) {
+    const unsigned i = unsigned(__builtin_ctz(bits));
+    if (intersect(rays.ray(i), rays.tnear[i], rays.tfar[i], out.hit[i])) out.mask |= 1u << i;
   }
 }
 
@@ -207,15 +200,18 @@ bool Quad::settledHit(int half, const Ray& ray, float tMin, float tMax, bool nee
   hit.ng = normal_;
   hit.uv = Vec2(0.0f);
   if (!needsUv) return true;
-  Vec2 b = coords_[half].at(glm::dvec3(ray.origin) + t * glm::dvec3(ray.dir));
-  if (singleFilter_) {
-    // (s, r) = b are the parallelogram's coordinates along v1 - v0 and v3 - v0. The half
-    // (v0, v1, v2) is s >= r, with barycentrics (s - r, r); the other has (s, r - s).
-    half = b.x >= b.y ? 0 : 1;
-    b = half == 0 ? Vec2(b.x - b.y, b.y) : Vec2(b.x, b.y - b.x);
-  }
-  hit.uv = uvAt(uv_[0], uv_[half == 0 ? 1 : 2], uv_[half == 0 ? 2 : 3], b.x, b.y);
+  const Vec2 b = coords_[half].at(glm::dvec3(ray.origin) + t * glm::dvec3(ray.dir));
+  hit.uv = singleFilter_ ? parallelogramUv(b)
+                         : uvAt(uv_[0], uv_[half == 0 ? 1 : 2], uv_[half == 0 ? 2 : 3], b.x, b.y);
   return true;
+}
+
+Vec2 Quad::parallelogramUv(Vec2 b) const {
+  // (s, r) = b are the parallelogram's coordinates along v1 - v0 and v3 - v0. The half
+  // (v0, v1, v2) is s >= r, with barycentrics (s - r, r); the other has (s, r - s).
+  const int half = b.x >= b.y ? 0 : 1;
+  b = half == 0 ? Vec2(b.x - b.y, b.y) : Vec2(b.x, b.y - b.x);
+  return uvAt(uv_[0], uv_[half == 0 ? 1 : 2], uv_[half == 0 ? 2 : 3], b.x, b.y);
 }
 
 // A half without area (a quad given as a triangle) is never hit; its filter, with NaN dual
@@ -244,14 +240,20 @@ void Quad::intersectLanes(const RayLanes& rays, LaneHits& out) const {
   TriangleLanes first;
   halfLanes(0, rays, first);
   if (singleFilter_) {
-    for (uint32_t bits = first.candidates; bits != 0; bits &= bits - 1) {
+    // The settled lanes at once (settledHit's crossing and coordinates in one kernel), the
+    // others by the exact test.
+    PlaneCrossings crossings;
+    out.mask = planeCrossings(rays, planes_[0], coords_[0], first.inside, rays.needsUv, crossings);
+    for (uint32_t bits = out.mask; bits != 0; bits &= bits - 1) {
       const unsigned i = unsigned(__builtin_ctz(bits));
-      const Ray ray = rays.ray(i);
-      const float tMin = rays.tnear[i];
       LocalHit& h = out.hit[i];
-      const bool hit = ((first.inside >> i) & 1u) ? settledHit(0, ray, tMin, ray.tMax, rays.needsUv, h)
-                                                  : intersect(ray, tMin, ray.tMax, h);
-      if (hit) out.mask |= 1u << i;
+      h.t = crossings.t[i];
+      h.ng = normal_;
+      h.uv = rays.needsUv ? parallelogramUv(Vec2(crossings.b[0][i], crossings.b[1][i])) : Vec2(0.0f);
+    }
+    for (uint32_t bits = first.candidates & ~first.inside; bits != 0; bits &= bits - 1) {
+      const unsigned i = unsigned(__builtin_ctz(bits));
+      if (intersect(rays.ray(i), rays.tnear[i], rays.tfar[i], out.hit[i])) out.mask |= 1u << i;
     }
     return;
   }

@@ -71,6 +71,8 @@ class Quad final : public Shape {
   // filter): t where the ray crosses the half's plane, if within the interval, and the UV of the
   // crossing point's barycentrics (with needsUv; else (0, 0)).
   bool settledHit(int half, const Ray& ray, float tMin, float tMax, bool needsUv, LocalHit& hit) const;
+  // The UV of the point with coordinates b in the single filter's parallelogram (v0, v1, v3).
+  Vec2 parallelogramUv(Vec2 b) const;
 
   bool rectangle_;
   std::array<Vec3, 4> v_;

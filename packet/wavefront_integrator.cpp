@@ -1,5 +1,6 @@
 #include "packet/wavefront_integrator.h"
 
+#include "accel/sampling_lanes.h"
 #include "renderer/sampler_lanes.h"
 
 #include <algorithm>
@@ -92,7 +93,8 @@ void sampleLights(Wave& wave, size_t queries, size_t lights) {
   // than a wave has vectors of queries, runs would stay short, and sorting would cost more than
   // it saves (2.5% of a render with 10,000 emitters).
   const auto keys = wave.queryKey.begin(), keysEnd = keys + ptrdiff_t(queries);
-  if (lights <= Wave::kSize / 16 && !std::is_sorted(keys, keysEnd)) std::sort(keys, keysEnd);
+  if (lights <= Wave::kSize / SolidAngleLanes::kMaxLanes && !std::is_sorted(keys, keysEnd))
+    std::sort(keys, keysEnd);
   for (size_t q = 0; q < queries; ++q) {
     const size_t v = wave.queryKey[q] & 0xffffu;
     wave.queryOf[v] = int16_t(q);
