@@ -1,5 +1,7 @@
 #include "renderer/light.h"
 
+#include "renderer/light_lanes.h"
+
 #include "accel/spherical_triangle.h"
 #include "core/ray_spawn.h"
 
@@ -68,16 +70,27 @@ bool AreaLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
 }
 
 void AreaLight::sampleLanes(const Vec3* refs, const Vec2* us, size_t n, LightSample* out, bool* ok) const {
-  SolidAngleLanes lanes;
+  SolidAngleLanes lanes{};  // shapes without a lane kernel fill only the live lanes
   for (size_t first = 0; first < n; first += SolidAngleLanes::kMaxLanes) {
     lanes.n = unsigned(std::min<size_t>(SolidAngleLanes::kMaxLanes, n - first));
     for (unsigned i = 0; i < lanes.n; ++i) lanes.set(i, refs[first + i], us[first + i]);
     lanes.padFrom(lanes.n);
     shape_->sampleSolidAngleLanes(lanes);
+    // fromShapeSample for the block: its directions in one kernel, equal to the scalar's.
+    LightDirectionLanes dirs;
+    lightDirectionLanes(lanes, dirs);
     for (unsigned i = 0; i < lanes.n; ++i) {
-      const float pdf = lanes.pdf[i];
-      ok[first + i] = pdf > 0.0f && fromShapeSample(refs[first + i], {lanes.point(i), lanes.normalAt(i)}, pdf,
-                                                    out[first + i]);
+      LightSample& s = out[first + i];
+      ok[first + i] = lanes.pdf[i] > 0.0f && dirs.dist[i] != 0.0f;
+      if (!ok[first + i]) continue;
+      s.dist = dirs.dist[i];
+      s.wi = Vec3(dirs.wi[0][i], dirs.wi[1][i], dirs.wi[2][i]);
+      s.p = lanes.point(i);
+      s.n = lanes.normalAt(i);
+      s.pError = pError_;
+      s.pdf = lanes.pdf[i];
+      s.delta = false;
+      s.Li = twoSided_ || ((dirs.facing >> i) & 1u) ? radiance_ : Color(0.0f);
     }
   }
 }
