@@ -115,7 +115,7 @@ class Shape {
 // sees exactly).
 struct DoublePlane {
   glm::dvec3 n{0.0, 0.0, 1.0};
-  double d = 0.0;
+  double d = 0.0;  // four doubles, no padding: two planes compare bit for bit with memcmp
 
   static DoublePlane through(const Vec3& anchor, const Vec3& normal);
   static DoublePlane through(const Vec3& a, const Vec3& b, const Vec3& c);

@@ -181,7 +181,9 @@ uint32_t SphereCandidates(const RayLanes& rays, const Vec3& center, float radius
 // Sphere::intersect for every candidate lane at once, in double precision: the same operations
 // in the same order (this file is compiled with -ffp-contract=off, and IEEE division and square
 // root round exactly), so each lane's hit equals the scalar routine's bit for bit. Lanes whose
-// direction has zero length (never traced: traceable() rejects them) are left to the caller.
+// direction has zero length (a = 0, solveQuadratic's linear branch) are left to the caller. On
+// the HWY_SCALAR and EMU128 targets (CPUs without SSSE3) DemoteTo clamps a t beyond FLT_MAX to
+// FLT_MAX where float(t) gives infinity: only a ray whose direction is ~1e-30 long can reach it.
 using D64 = hn::CappedTag<double, RayLanes::kMaxLanes / 2>;
 using V64 = hn::Vec<D64>;
 
@@ -220,7 +222,8 @@ uint32_t SphereHitsKernel(const RayLanes& rays, const Vec3& center, float radius
     const V64 root = hn::Sqrt(discrim);
     const V64 q = hn::Mul(half, hn::IfThenElse(hn::Lt(b, zero), hn::Sub(b, root), hn::Add(b, root)));
     V64 t0 = hn::Div(q, a);
-    V64 t1 = hn::IfThenElse(hn::Ne(q, zero), hn::Div(c, q), t0);
+    // q != 0.0 as C++ has it (true for NaN): not Ne, which is an ordered compare on AVX2/AVX-512.
+    V64 t1 = hn::IfThenElse(hn::Not(hn::Eq(q, zero)), hn::Div(c, q), t0);
     const auto swap = hn::Gt(t0, t1);
     const V64 lo = hn::IfThenElse(swap, t1, t0), hi = hn::IfThenElse(swap, t0, t1);
     // The nearer root within (tMin, tMax), else the farther one.

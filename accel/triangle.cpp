@@ -1,5 +1,7 @@
 #include "accel/triangle.h"
 
+#include <cstring>
+
 #include "accel/spherical_rectangle.h"
 #include "accel/spherical_triangle.h"
 #include "core/sampling.h"
@@ -145,7 +147,8 @@ Quad::Quad(const std::array<Vec3, 4>& v, const std::array<Vec2, 4>& uv)
   // A degenerate half (a quad given as a triangle, v3 = v0) has no plane of its own.
   if (!(area1_ > 0.0f)) planes_[1] = planes_[0];
   if (!(area0_ > 0.0f)) planes_[0] = planes_[1];
-  samePlanes_ = planes_[0].n == planes_[1].n && planes_[0].d == planes_[1].d;
+  // Bit for bit (+0 and -0 differ), so that skipping the side test never changes a projection.
+  samePlanes_ = std::memcmp(&planes_[0], &planes_[1], sizeof(DoublePlane)) == 0;
   // An exact parallelogram (v2 = v1 + v3 - v0, which double evaluates without rounding) whose
   // halves lie in planes agreeing far below the filter's float tolerance is filtered in one test.
   const glm::dvec3 opposite = glm::dvec3(v[1]) + glm::dvec3(v[3]) - glm::dvec3(v[0]);

@@ -52,16 +52,16 @@ ImageTexture::ImageTexture(int width, int height, std::vector<Color> texels, Tex
   }
   if (!texels_.empty()) average_ = sum / float(texels_.size());
 
+  // First the palettes, which an HDR image overflows within its first few hundred texels; the
+  // indices only once they fit.
   ChannelPalette channels[3];
-  std::vector<uint8_t> indices(3 * texels_.size());
-  for (size_t i = 0; i < texels_.size(); ++i) {
-    for (int c = 0; c < 3; ++c) {
-      const int k = channels[c].index(texels_[i][c], palette_[size_t(c)]);
-      if (k < 0) return;  // more than 256 values: the floats stay
-      indices[3 * i + size_t(c)] = uint8_t(k);
-    }
-  }
-  indices_ = std::move(indices);
+  for (const Color& t : texels_)
+    for (int c = 0; c < 3; ++c)
+      if (channels[c].index(t[c], palette_[size_t(c)]) < 0) return;  // more than 256 values: floats stay
+  indices_.resize(3 * texels_.size());
+  for (size_t i = 0; i < texels_.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      indices_[3 * i + size_t(c)] = uint8_t(channels[c].index(texels_[i][c], palette_[size_t(c)]));
   paletted_ = true;
   std::vector<Color>().swap(texels_);
 }

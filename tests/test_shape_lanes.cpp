@@ -18,6 +18,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <functional>
 #include <memory>
 #include <string>
@@ -93,8 +94,10 @@ bool sameHit(const LocalHit& a, const LocalHit& b, float uvScale) {
   return t && uv && a.ng == b.ng;
 }
 
+// Bit for bit: +0 and -0 differ, and so do NaNs of different payloads.
 bool identical(const LocalHit& a, const LocalHit& b) {
-  return a.t == b.t && a.ng == b.ng && a.uv == b.uv;
+  return std::memcmp(&a.t, &b.t, sizeof a.t) == 0 && std::memcmp(&a.ng, &b.ng, sizeof a.ng) == 0 &&
+         std::memcmp(&a.uv, &b.uv, sizeof a.uv) == 0;
 }
 
 using RayMaker = std::function<Ray(Rng&)>;
@@ -386,6 +389,92 @@ TEST(ShapeLanes, KernelSettlesHitsAwayFromEdges) {
       EXPECT_GE(settled, rays * 95 / 100) << settled << " of " << rays << " settled";
     }
   }
+}
+
+}  // namespace
+}  // namespace ember
+
+namespace ember {
+namespace {
+
+// The settled hits' double-precision kernel must be DoublePlane::crossedWithin (measured from the
+// anchor v0) and PlaneCoordinates::at bit for bit, on every lane it is given, hit or not:
+// rays near and far from the origin, intervals that start past the plane or end before it,
+// and rays parallel to the plane.
+TEST(ShapeLanes, PlaneCrossingsKernelEqualsTheScalarCrossing) {
+  for (const auto& [at, size] : {std::pair{Vec3(0.0f), 1.0f}, std::pair{Vec3(6e3f, -3.5e3f, 1.1e4f), 2.0f}}) {
+    const Vec3 v0 = at + size * Vec3(-1, -0.3f, 0.2f), v1 = at + size * Vec3(0.9f, 0.1f, -0.4f),
+               v2 = at + size * Vec3(0.1f, 1.1f, 0.3f);
+    const DoublePlane plane = DoublePlane::through(v0, v1, v2);
+    const PlaneCoordinates coords = PlaneCoordinates::of(v0, v1, v2);
+    const Vec3 n = glm::normalize(glm::cross(v1 - v0, v2 - v0));
+    Rng rng(11, 4);
+    int hits = 0, lanes = 0;
+    for (int b = 0; b < 300; ++b) {
+      Block block;
+      for (unsigned i = 0; i < RayLanes::kMaxLanes; ++i) {
+        const Vec3 target = v0 + rng.uniform() * (v1 - v0) + rng.uniform() * (v2 - v0);
+        const Vec3 o = target + size * (0.01f + 3.0f * rng.uniform()) * randomDirection(rng);
+        Vec3 d = glm::normalize(target - o);
+        if (i == 3) d = glm::normalize(glm::cross(n, d));  // parallel to the plane
+        block.set(i, Ray{o, d, rng.uniform() < 0.2f ? 0.5f * glm::length(target - o) : kInfinity}, true);
+        if (rng.uniform() < 0.2f) block.tnear[i] = 2.0f * glm::length(target - o);  // starts past it
+      }
+      const unsigned n16 = b % 4 == 0 ? 1 + unsigned(rng.uniform() * 15.0f) : RayLanes::kMaxLanes;
+      const uint32_t want = (n16 >= 32 ? ~0u : (1u << n16) - 1u) & 0xb7ffu;  // some lanes not asked
+      PlaneCrossings out;
+      const uint32_t mask = planeCrossings(block.lanes(n16), plane, coords, want, true, out);
+      for (unsigned i = 0; i < RayLanes::kMaxLanes; ++i) {
+        const bool asked = (want >> i) & 1u;
+        const bool laneHit = (mask >> i) & 1u;
+        if (!asked) {
+          EXPECT_FALSE(laneHit) << "lane " << i << " was not asked for";
+          continue;
+        }
+        ++lanes;
+        const RayLanes r = block.lanes(n16);
+        const Ray ray = r.ray(i);
+        double t;
+        const bool hit = plane.crossedWithin(ray, r.tnear[i], ray.tMax, coords.v0, t);
+        ASSERT_EQ(laneHit, hit) << "lane " << i << ": " << describe(ray);
+        if (!hit) continue;
+        ++hits;
+        const float tf = float(t);
+        const Vec2 bc = coords.at(glm::dvec3(ray.origin) + t * glm::dvec3(ray.dir));
+        EXPECT_EQ(std::memcmp(&tf, &out.t[i], sizeof tf), 0) << describe(ray);
+        EXPECT_EQ(std::memcmp(&bc.x, &out.b[0][i], sizeof(float)), 0) << describe(ray);
+        EXPECT_EQ(std::memcmp(&bc.y, &out.b[1][i], sizeof(float)), 0) << describe(ray);
+      }
+    }
+    EXPECT_GT(hits, lanes / 2);  // most rays are aimed at the triangle
+  }
+}
+
+// A live lane with a zero direction (which traceable() lets through) takes the sphere's scalar
+// routine, and its neighbours keep their kernel hits.
+TEST(ShapeLanes, SphereLaneWithAZeroDirectionGetsTheScalarResult) {
+  const Sphere sphere(Vec3(0.0f), 1.0f);
+  Block block;
+  Rng rng(2, 9);
+  for (unsigned i = 0; i < RayLanes::kMaxLanes; ++i) {
+    const Vec3 o = 3.0f * randomDirection(rng);
+    block.set(i, Ray{o, glm::normalize(0.2f * randomDirection(rng) - o)}, true);
+  }
+  for (int k = 0; k < 3; ++k) block.dir[k][5] = 0.0f;
+  for (int k = 0; k < 3; ++k) block.org[k][9] = 0.0f;  // inside, at the centre
+  for (int k = 0; k < 3; ++k) block.dir[k][9] = 0.0f;
+  LaneHits hits;
+  sphere.intersectLanes(block.lanes(), hits);
+  for (unsigned i = 0; i < RayLanes::kMaxLanes; ++i) {
+    LocalHit h;
+    const bool hit = sphere.intersect(block.lanes().ray(i), block.tnear[i], block.tfar[i], h);
+    ASSERT_EQ(((hits.mask >> i) & 1u) != 0, hit) << "lane " << i;
+    if (hit) {
+      EXPECT_TRUE(identical(hits.hit[i], h)) << "lane " << i;
+    }
+  }
+  EXPECT_FALSE((hits.mask >> 5) & 1u);
+  EXPECT_EQ(__builtin_popcount(hits.mask), 14);
 }
 
 }  // namespace
