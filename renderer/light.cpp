@@ -80,34 +80,35 @@ void AreaLight::sampleLanes(const Vec3* refs, const Vec2* us, size_t n, LightSam
     LightDirectionLanes dirs;
     lightDirectionLanes(lanes, dirs);
     for (unsigned i = 0; i < lanes.n; ++i) {
-      LightSample& s = out[first + i];
       ok[first + i] = lanes.pdf[i] > 0.0f && dirs.dist[i] != 0.0f;
-      if (!ok[first + i]) continue;
-      s.dist = dirs.dist[i];
-      s.wi = Vec3(dirs.wi[0][i], dirs.wi[1][i], dirs.wi[2][i]);
-      s.p = lanes.point(i);
-      s.n = lanes.normalAt(i);
-      s.pError = pError_;
-      s.pdf = lanes.pdf[i];
-      s.delta = false;
-      s.Li = twoSided_ || ((dirs.facing >> i) & 1u) ? radiance_ : Color(0.0f);
+      if (ok[first + i])
+        fillSample({lanes.point(i), lanes.normalAt(i)}, lanes.pdf[i], dirs.dist[i],
+                   Vec3(dirs.wi[0][i], dirs.wi[1][i], dirs.wi[2][i]), (dirs.facing >> i) & 1u,
+                   out[first + i]);
     }
   }
 }
 
 bool AreaLight::fromShapeSample(const Vec3& ref, const ShapeSample& s, float pdf, LightSample& out) const {
   const Vec3 d = s.p - ref;
-  out.dist = glm::length(d);
-  if (out.dist == 0.0f) return false;
-  out.wi = d / out.dist;
+  const float dist = glm::length(d);
+  if (dist == 0.0f) return false;
+  const Vec3 wi = d / dist;
+  fillSample(s, pdf, dist, wi, glm::dot(-wi, s.n) > 0.0f, out);
+  return true;
+}
+
+void AreaLight::fillSample(const ShapeSample& s, float pdf, float dist, const Vec3& wi, bool facing,
+                           LightSample& out) const {
+  out.dist = dist;
+  out.wi = wi;
   out.p = s.p;
   out.n = s.n;
   out.pError = pError_;
   out.pdf = pdf;
   out.delta = false;
   // One-sided: the light emits only towards the side its normal faces.
-  out.Li = twoSided_ || glm::dot(-out.wi, s.n) > 0.0f ? radiance_ : Color(0.0f);
-  return true;
+  out.Li = twoSided_ || facing ? radiance_ : Color(0.0f);
 }
 
 TriangleLight::TriangleLight(const TriangleMesh* mesh, uint32_t prim, const Color& radiance,

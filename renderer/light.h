@@ -116,6 +116,10 @@ class AreaLight final : public Light {
  private:
   // The light sample from the shape's sample (s, pdf) seen from ref.
   bool fromShapeSample(const Vec3& ref, const ShapeSample& s, float pdf, LightSample& out) const;
+  // The light sample of (s, pdf) at distance `dist` in direction wi, `facing` when s.n faces the
+  // reference point: what fromShapeSample and sampleLanes' kernel both end with.
+  void fillSample(const ShapeSample& s, float pdf, float dist, const Vec3& wi, bool facing,
+                  LightSample& out) const;
 
   const Shape* shape_;
   Color radiance_;

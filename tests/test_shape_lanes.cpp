@@ -18,6 +18,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstring>
 #include <functional>
 #include <memory>
@@ -353,13 +354,18 @@ TEST(ShapeLanes, FiltersKeepEveryHitFarFromTheOrigin) {
 namespace ember {
 namespace {
 
+// A triangle of about `size` at `at`, neither axis-aligned nor right-angled.
+std::array<Vec3, 3> testTriangle(const Vec3& at, float size) {
+  return {at + size * Vec3(-1, -0.3f, 0.2f), at + size * Vec3(0.9f, 0.1f, -0.4f),
+          at + size * Vec3(0.1f, 1.1f, 0.3f)};
+}
+
 // The speed of flat shapes comes from the kernel settling the hits away from their edges: rays
 // aimed at interior points (barycentric margin >= 0.05) from a few sizes away must nearly all be
 // settled, near the origin and far from it.
 TEST(ShapeLanes, KernelSettlesHitsAwayFromEdges) {
   for (const auto& [at, size] : {std::pair{Vec3(0.0f), 1.0f}, std::pair{Vec3(6e3f, -3.5e3f, 1.1e4f), 2.0f}}) {
-    const Vec3 v0 = at + size * Vec3(-1, -0.3f, 0.2f), v1 = at + size * Vec3(0.9f, 0.1f, -0.4f),
-               v2 = at + size * Vec3(0.1f, 1.1f, 0.3f);
+    const auto [v0, v1, v2] = testTriangle(at, size);
     const DoublePlane plane = DoublePlane::through(v0, v1, v2);
     for (const bool parallelogram : {false, true}) {
       SCOPED_TRACE(std::string(parallelogram ? "parallelogram" : "triangle") + " at " + std::to_string(at.x));
@@ -403,8 +409,7 @@ namespace {
 // and rays parallel to the plane.
 TEST(ShapeLanes, PlaneCrossingsKernelEqualsTheScalarCrossing) {
   for (const auto& [at, size] : {std::pair{Vec3(0.0f), 1.0f}, std::pair{Vec3(6e3f, -3.5e3f, 1.1e4f), 2.0f}}) {
-    const Vec3 v0 = at + size * Vec3(-1, -0.3f, 0.2f), v1 = at + size * Vec3(0.9f, 0.1f, -0.4f),
-               v2 = at + size * Vec3(0.1f, 1.1f, 0.3f);
+    const auto [v0, v1, v2] = testTriangle(at, size);
     const DoublePlane plane = DoublePlane::through(v0, v1, v2);
     const PlaneCoordinates coords = PlaneCoordinates::of(v0, v1, v2);
     const Vec3 n = glm::normalize(glm::cross(v1 - v0, v2 - v0));
