@@ -3,6 +3,7 @@
 #include "accel/shape.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace ember {
 
@@ -104,14 +105,26 @@ void shapeIntersectCallback(const RTCIntersectFunctionNArguments* args) {
   RTCRayN* rays = RTCRayHitN_RayN(args->rayhit, args->N);
   RTCHitN* hits = RTCRayHitN_HitN(args->rayhit, args->N);
   const unsigned n = args->N;
+  // Shapes report hits with t strictly inside (tnear, tfar), but compute t in double: a hit whose
+  // t rounds onto the current tfar would be kept by the shape Embree happens to visit first, and
+  // Embree visits them in another order for single rays than for packets. So the shapes see tfar
+  // one float step further, and every hit that rounds onto tfar reaches the rule below.
+  float tfar[RayLanes::kMaxLanes];  // Embree calls with packets of 16 or single rays (PacketLanes)
+  for (unsigned i = 0; i < n; ++i) {
+    tfar[i] = RTCRayN_tfar(rays, n, i);
+    if (args->valid[i]) RTCRayN_tfar(rays, n, i) = std::nextafter(tfar[i], kInfinity);
+  }
   intersectPacket(*geometry->shape, geometry->needsUv, rays, n, args->valid,
                   [&](unsigned i, const LocalHit& h) {
-                    // A hit at exactly the current tfar (its t rounded onto it) ties with the hit found
-                    // there: the smaller geomID keeps it, so that the result among analytic shapes does not
-                    // depend on the order Embree visits them in, which differs between single rays and
-                    // packets.
-                    if (h.t == RTCRayN_tfar(rays, n, i) && RTCHitN_geomID(hits, n, i) <= args->geomID) return;
-                    RTCRayN_tfar(rays, n, i) = h.t;
+                    if (!(h.t <= tfar[i])) return;
+                    // A hit at exactly the current tfar ties with the hit found there: the smaller
+                    // geomID keeps it, so that the result does not depend on the order Embree visits
+                    // the shapes in. With no hit yet, tfar is the ray's own end, which is open.
+                    if (h.t == tfar[i]) {
+                      const unsigned current = RTCHitN_geomID(hits, n, i);
+                      if (current == RTC_INVALID_GEOMETRY_ID || current <= args->geomID) return;
+                    }
+                    tfar[i] = h.t;
                     RTCHitN_Ng_x(hits, n, i) = h.ng.x;
                     RTCHitN_Ng_y(hits, n, i) = h.ng.y;
                     RTCHitN_Ng_z(hits, n, i) = h.ng.z;
@@ -121,6 +134,8 @@ void shapeIntersectCallback(const RTCIntersectFunctionNArguments* args) {
                     RTCHitN_geomID(hits, n, i) = args->geomID;
                     RTCHitN_instID(hits, n, i, 0) = args->context->instID[0];
                   });
+  for (unsigned i = 0; i < n; ++i)
+    if (args->valid[i]) RTCRayN_tfar(rays, n, i) = tfar[i];
 }
 
 void shapeOccludedCallback(const RTCOccludedFunctionNArguments* args) {

@@ -50,6 +50,12 @@ Runner addInfoCommand(CLI::App& app) {
         punctualLights, emitters, twoSidedEmitters, emissiveTriangles, twoSidedTriangles,
         scene.environment() ? "1" : "no");
     std::printf("strategy:   %s\n", std::string(strategyName(rs.strategy)).c_str());
+    const CausticTracer& caustics = scene.causticTracer();
+    if (!rs.traceCaustics || !caustics.enabled())
+      std::printf("caustics:   path-traced (%s)\n",
+                  rs.traceCaustics ? caustics.whyDisabled() : "render.caustic_tracing is off");
+    else
+      std::printf("caustics:   light-traced, %zu specular object(s)\n", caustics.casters().size());
     std::printf("materials:  %zu", scene.materials.size());
     for (size_t i = 0; i < scene.materials.size(); ++i)
       std::printf("%s %s (%s)", i ? "," : "", scene.materialNames[i].c_str(),

@@ -36,6 +36,7 @@ struct RenderArgs {
   uint64_t firstSample = 0;
   std::string sampler;
   std::string strategy;
+  std::string caustics;
   std::string kernel = "wavefront";
   std::string env;
   bool quiet = false;
@@ -131,6 +132,7 @@ RenderSetup setUp(RenderArgs& a) {
                                                    {a.maxDepth.has_value(), "--max-depth"},
                                                    {!a.sampler.empty(), "--sampler"},
                                                    {!a.strategy.empty(), "--strategy"},
+                                                   {!a.caustics.empty(), "--caustics"},
                                                    {!a.env.empty(), "--env"},
                                                    {a.camera >= 0, "--camera"},
                                                    {a.firstSample != 0, "--first-sample"},
@@ -157,6 +159,7 @@ RenderSetup setUp(RenderArgs& a) {
     s.seed = id.seed;
     s.sampler = id.sampler == "sobol" ? SamplerType::Sobol : SamplerType::Independent;
     s.strategy = parseStrategy(id.strategy).value_or(Strategy::Mis);
+    s.traceCaustics = id.caustics == "trace";
     s.spp = a.spp.value_or(c.spp);
     const int held = std::min(c.spp, c.passes * c.passSpp);
     if (s.spp < held)
@@ -189,6 +192,7 @@ RenderSetup setUp(RenderArgs& a) {
   if (a.sampler == "sobol") s.sampler = SamplerType::Sobol;
   if (a.sampler == "independent") s.sampler = SamplerType::Independent;
   if (!a.strategy.empty()) s.strategy = *parseStrategy(a.strategy);  // CLI11 checked the name
+  if (!a.caustics.empty()) s.traceCaustics = a.caustics == "trace";
   setup.identity = identityOf(setup.scene, a.scene, a.camera, a.env);
   setup.firstSample = a.firstSample;
   setup.passSpp = a.passSpp.value_or(4);
@@ -279,6 +283,7 @@ int runRender(RenderArgs a) {
                       {"ember:seed", std::to_string(s.seed)},
                       {"ember:sampler", s.sampler == SamplerType::Sobol ? "sobol" : "independent"},
                       {"ember:strategy", std::string(strategyName(s.strategy))},
+                      {"ember:caustics", setup.identity.caustics},
                       {"ember:max_depth", std::to_string(s.maxDepth)},
                       {"ember:rr_depth", std::to_string(s.rrDepth)},
                       {"ember:first_sample", std::to_string(setup.firstSample)},
@@ -359,6 +364,12 @@ Runner addRenderCommand(CLI::App& app) {
          "vertex; emitters seen by the camera or through mirrors and glass still count); "
          "default: the scene's render.strategy")
       ->check(CLI::IsMember({"mis", "bsdf", "light"}));
+  cmd->add_option("--caustics", args->caustics,
+                  "How caustics (light through mirrors and glass onto diffuse surfaces) are estimated, both "
+                  "unbiased: trace (light paths from the area lights towards the specular objects, connected "
+                  "to the camera: far less noise; the default) or path (the path tracer alone); default: the "
+                  "scene's render.caustic_tracing")
+      ->check(CLI::IsMember({"trace", "path"}));
   cmd->add_option("--kernel", args->kernel,
                   "How paths are traced, all giving the same image: wavefront (16-wide Embree packets, the "
                   "default), stream (Embree ray streams) or scalar (one ray at a time, the reference)")

@@ -57,6 +57,7 @@ uint64_t RenderIdentity::hash() const {
   feedValue(s, seed);
   feed(s, sampler);
   feed(s, strategy);
+  feed(s, caustics);
   feedValue(s, camera);
   feed(s, env);
   return XXH3_64bits_digest(s);
@@ -71,9 +72,9 @@ std::string hexHash(uint64_t h) {
 nlohmann::json RenderIdentity::toJson() const {
   nlohmann::json fs = nlohmann::json::array();
   for (const File& f : files) fs.push_back({{"path", f.path}, {"xxh3", hexHash(f.hash)}});
-  return {{"scene", scene},        {"files", fs},         {"width", width}, {"height", height},
-          {"max_depth", maxDepth}, {"rr_depth", rrDepth}, {"seed", seed},   {"sampler", sampler},
-          {"strategy", strategy},  {"camera", camera},    {"env", env}};
+  return {{"scene", scene},        {"files", fs},          {"width", width},   {"height", height},
+          {"max_depth", maxDepth}, {"rr_depth", rrDepth},  {"seed", seed},     {"sampler", sampler},
+          {"strategy", strategy},  {"caustics", caustics}, {"camera", camera}, {"env", env}};
 }
 
 RenderIdentity RenderIdentity::fromJson(const nlohmann::json& j, const std::string& origin) {
@@ -90,6 +91,9 @@ RenderIdentity RenderIdentity::fromJson(const nlohmann::json& j, const std::stri
     id.seed = j.at("seed").get<uint64_t>();
     id.sampler = j.at("sampler").get<std::string>();
     id.strategy = j.at("strategy").get<std::string>();
+    id.caustics = j.at("caustics").get<std::string>();
+    if (id.caustics != "trace" && id.caustics != "path")
+      throw InputError(origin + ": caustics '" + id.caustics + "' is neither trace nor path");
     id.camera = j.at("camera").get<int>();
     id.env = j.at("env").get<std::string>();
     if (id.width <= 0 || id.height <= 0 || id.width > 16384 || id.height > 16384)
@@ -121,6 +125,7 @@ std::string RenderIdentity::differenceFrom(const RenderIdentity& now) const {
   if (seed != now.seed) return differs("the seed", seed, now.seed);
   if (sampler != now.sampler) return differs("the sampler", sampler, now.sampler);
   if (strategy != now.strategy) return differs("the strategy", strategy, now.strategy);
+  if (caustics != now.caustics) return differs("caustics", caustics, now.caustics);
   if (camera != now.camera) return differs("the camera", camera, now.camera);
   if (env != now.env) return differs("the environment", "'" + env + "'", "'" + now.env + "'");
   return "";
@@ -139,6 +144,7 @@ RenderIdentity identityOf(const Scene& scene, const std::string& sceneArg, int c
   id.seed = s.seed;
   id.sampler = s.sampler == SamplerType::Sobol ? "sobol" : "independent";
   id.strategy = std::string(strategyName(s.strategy));
+  id.caustics = s.traceCaustics ? "trace" : "path";
   id.camera = camera;
   id.env = env;
   return id;

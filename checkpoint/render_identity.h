@@ -24,8 +24,9 @@ struct RenderIdentity {
   int width = 0, height = 0, maxDepth = 0, rrDepth = 0;
   uint64_t seed = 0;
   std::string sampler, strategy;
-  int camera = -1;  // --camera
-  std::string env;  // --env, verbatim (its file, if any, is among `files`)
+  std::string caustics = "trace";  // "trace": light-traced caustics (renderer/caustic_tracer.h), "path": not
+  int camera = -1;                 // --camera
+  std::string env;                 // --env, verbatim (its file, if any, is among `files`)
 
   // XXH3-64 over the files' hashes and every setting above: equal iff the renders are the same.
   uint64_t hash() const;

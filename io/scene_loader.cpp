@@ -86,7 +86,8 @@ class JsonSceneLoader {
   }
 
   void readRender(const JsonNode& n) {
-    n.allowKeys({"spp", "max_depth", "rr_depth", "seed", "background", "sampler", "strategy"});
+    n.allowKeys(
+        {"spp", "max_depth", "rr_depth", "seed", "background", "sampler", "strategy", "caustic_tracing"});
     RenderSettings& s = scene_.settings;
     if (n.has("spp")) s.spp = n.at("spp").integer(1, 1 << 24);
     if (n.has("max_depth")) s.maxDepth = n.at("max_depth").integer(-1, 100000);
@@ -107,6 +108,7 @@ class JsonSceneLoader {
       if (!parsed) strategy->fail("unknown strategy '" + v + "'; valid: " + std::string(kStrategyNames));
       s.strategy = *parsed;
     }
+    s.traceCaustics = n.boolean("caustic_tracing", s.traceCaustics);
     scene_.background = n.color("background", Color(0.0f));
   }
 

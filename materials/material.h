@@ -44,6 +44,9 @@ class Material {
 
   // Whether eval can be non-zero, i.e. light sampling is worth a shadow ray.
   virtual bool hasNonDeltaLobes() const { return true; }
+  // Whether sample() can return a Dirac lobe (a mirror or a smooth refraction): such surfaces
+  // cast caustics (renderer/caustic_tracer.h).
+  virtual bool hasDeltaLobes() const { return false; }
 
   // Whether any of its parameters is a texture, i.e. its hits need texture coordinates. Hits on
   // analytic shapes skip the UV (the sphere's inverse trigonometry) when the material reads none.

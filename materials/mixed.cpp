@@ -9,6 +9,10 @@ bool Mixed::hasNonDeltaLobes() const {
   return !isBlack(c_.kd->maxValue()) || !isBlack(c_.ks);
 }
 
+bool Mixed::hasDeltaLobes() const {
+  return !isBlack(c_.kr) || !isBlack(c_.kt);
+}
+
 Color Mixed::eval(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const {
   if (!sameSide(hit, wo, wi)) return Color(0.0f);
   const Vec3 n = facingNormal(hit, wo);

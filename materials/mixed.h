@@ -32,6 +32,7 @@ class Mixed final : public Material {
   float pdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const override;
   bool sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float uLobe, BsdfSample& out) const override;
   bool hasNonDeltaLobes() const override;
+  bool hasDeltaLobes() const override;
   bool readsUv() const override { return !c_.kd->isConstant(); }  // kd is its only texture
 
  private:

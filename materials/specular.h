@@ -23,6 +23,7 @@ class Mirror final : public Material {
   float pdf(const SurfaceHit&, const Vec3&, const Vec3&) const override { return 0.0f; }
   bool sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float uLobe, BsdfSample& out) const override;
   bool hasNonDeltaLobes() const override { return false; }
+  bool hasDeltaLobes() const override { return true; }
   bool readsUv() const override { return false; }
 
  private:
@@ -38,6 +39,7 @@ class Refraction final : public Material {
   float pdf(const SurfaceHit&, const Vec3&, const Vec3&) const override { return 0.0f; }
   bool sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float uLobe, BsdfSample& out) const override;
   bool hasNonDeltaLobes() const override { return false; }
+  bool hasDeltaLobes() const override { return true; }
   bool readsUv() const override { return false; }
 
  private:
@@ -53,6 +55,7 @@ class Dielectric final : public Material {
   float pdf(const SurfaceHit&, const Vec3&, const Vec3&) const override { return 0.0f; }
   bool sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float uLobe, BsdfSample& out) const override;
   bool hasNonDeltaLobes() const override { return false; }
+  bool hasDeltaLobes() const override { return true; }
   bool readsUv() const override { return false; }
 
  private:

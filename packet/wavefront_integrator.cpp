@@ -1,6 +1,7 @@
 #include "packet/wavefront_integrator.h"
 
 #include "accel/sampling_lanes.h"
+#include "packet/caustic_wave.h"
 #include "renderer/sampler_lanes.h"
 
 #include <algorithm>
@@ -126,6 +127,13 @@ void sampleBsdfs(Wave& wave, size_t vertices) {
 
 }  // namespace
 
+void WavefrontIntegrator::traceCaustics(const Scene& scene, uint64_t seed, SamplerType sampler,
+                                        uint64_t firstIndex, int count, CausticSplats& splats,
+                                        PathStats& stats) const {
+  traceCausticsInWaves(scene, maxDepth(), rrDepth(), seed, sampler, firstIndex, count, splats, stats,
+                       traversal_);
+}
+
 void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, Film& film,
                                      PathStats& stats) const {
   Wave& wave = threadWave();
@@ -233,7 +241,8 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
     }
 
     for (size_t i = 0; i < count; ++i)
-      addToFilm(film, wave.lanes[i].x, wave.lanes[i].y, wave.lanes[i].path.radiance, stats);
+      addToFilm(film, work, wave.lanes[i].x, wave.lanes[i].y, int((first + i) / pixels),
+                wave.lanes[i].path.radiance, stats);
   }
 }
 

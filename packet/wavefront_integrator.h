@@ -36,6 +36,12 @@ class WavefrontIntegrator final : public Integrator {
     return path_.Li(scene, ray, sampler, stats);
   }
   void renderTile(const Scene& scene, const TileWork& work, Film& film, PathStats& stats) const override;
+  bool tracesCaustics() const override { return path_.tracesCaustics(); }
+  // The light paths in waves too (packet/caustic_wave.h).
+  void traceCaustics(const Scene& scene, uint64_t seed, SamplerType sampler, uint64_t firstIndex, int count,
+                     CausticSplats& splats, PathStats& stats) const override;
+  int maxDepth() const override { return path_.maxDepth(); }
+  int rrDepth() const override { return path_.rrDepth(); }
 
  private:
   PathIntegrator path_;

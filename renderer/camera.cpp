@@ -13,6 +13,8 @@ Camera::Camera(const CameraParams& params, int width, int height)
       aspect_(float(width) / float(height)),
       invWidth_(1.0f / float(width)),
       invHeight_(1.0f / float(height)),
-      orthographic_(params.projection == Projection::Orthographic) {}
+      orthographic_(params.projection == Projection::Orthographic),
+      width_(width),
+      height_(height) {}
 
 }  // namespace ember

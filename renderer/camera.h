@@ -33,12 +33,35 @@ class Camera {
     return Ray{origin_, glm::normalize(forward_ + sx * right_ + sy * up_)};
   }
   const CameraParams& params() const { return params_; }
+  int width() const { return width_; }
+  int height() const { return height_; }
+  bool perspective() const { return !orthographic_; }
+  const Vec3& origin() const { return origin_; }
+  // Area of the perspective image plane at unit distance: (2 t W/H) x (2 t).
+  float imagePlaneArea() const { return 4.0f * scale_ * scale_ * aspect_; }
+
+  // Where a perspective camera sees the point p: its raster position in [0, W) x [0, H) and the
+  // cosine between the direction to it and the view axis; false when p is behind the camera or
+  // outside the image. The inverse of generateRay.
+  bool project(const Vec3& p, Vec2& raster, float& cosTheta) const {
+    const Vec3 v = p - origin_;
+    const float z = glm::dot(v, forward_);
+    if (!(z > 0.0f)) return false;
+    const float sx = glm::dot(v, right_) / (z * scale_ * aspect_);
+    const float sy = glm::dot(v, up_) / (z * scale_);
+    raster = Vec2((sx + 1.0f) * 0.5f * float(width_), (1.0f - sy) * 0.5f * float(height_));
+    if (!(raster.x >= 0.0f && raster.x < float(width_) && raster.y >= 0.0f && raster.y < float(height_)))
+      return false;
+    cosTheta = z / glm::length(v);
+    return true;
+  }
 
  private:
   CameraParams params_;
   Vec3 origin_, forward_, right_, up_;
   float scale_, aspect_, invWidth_, invHeight_;  // scale_: tan(fov / 2), or ymag
   bool orthographic_;
+  int width_, height_;
 };
 
 }  // namespace ember

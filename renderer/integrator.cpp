@@ -18,6 +18,16 @@ void addToFilm(Film& film, int x, int y, const Color& L, PathStats& stats) {
   }
 }
 
+void addToFilm(Film& film, const TileWork& work, int x, int y, int s, const Color& L, PathStats& stats) {
+  addToFilm(film, x, y, work.caustics ? L + work.caustics->at(s, x, y) : L, stats);
+}
+
+void Integrator::traceCaustics(const Scene& scene, uint64_t seed, SamplerType sampler, uint64_t firstIndex,
+                               int count, CausticSplats& splats, PathStats& stats) const {
+  scene.causticTracer().traceAlone(scene, maxDepth(), rrDepth(), seed, sampler, firstIndex, count, splats,
+                                   stats);
+}
+
 void Integrator::renderTile(const Scene& scene, const TileWork& work, Film& film, PathStats& stats) const {
   const uint64_t width = uint64_t(film.width());
   for (int y = work.y0; y < work.y1; ++y)
@@ -26,7 +36,7 @@ void Integrator::renderTile(const Scene& scene, const TileWork& work, Film& film
       for (int s = 0; s < work.spp; ++s) {
         Sampler sampler(work.sampler, work.seed, pixel, work.firstSample + uint64_t(s));
         const Ray ray = cameraRay(scene, x, y, sampler);
-        addToFilm(film, x, y, Li(scene, ray, sampler, stats), stats);
+        addToFilm(film, work, x, y, s, Li(scene, ray, sampler, stats), stats);
       }
     }
 }

@@ -33,6 +33,9 @@ struct TileWork {
   int spp = 1;
   uint64_t seed = 0;
   SamplerType sampler = SamplerType::Independent;
+  // The light tracer's splats for the pass (image s for sample index firstSample + s), added to
+  // each sample; null when the render traces no caustics.
+  const CausticSplats* caustics = nullptr;
 };
 
 class Integrator {
@@ -45,6 +48,17 @@ class Integrator {
   // that estimates the same paths produces the same film. This one traces each path alone, one
   // ray at a time, pixel by pixel.
   virtual void renderTile(const Scene& scene, const TileWork& work, Film& film, PathStats& stats) const;
+
+  // Whether this estimator leaves caustic paths to the scene's light tracer
+  // (renderer/caustic_tracer.h), which render() then runs before each pass, and the path-length
+  // settings the tracer must share with it.
+  virtual bool tracesCaustics() const { return false; }
+  // The light paths of sample indices firstIndex + [0, count) into splats' images 0 .. count - 1,
+  // in parallel on the calling thread's task arena (CausticTracer::traceAlone by default).
+  virtual void traceCaustics(const Scene& scene, uint64_t seed, SamplerType sampler, uint64_t firstIndex,
+                             int count, CausticSplats& splats, PathStats& stats) const;
+  virtual int maxDepth() const { return -1; }
+  virtual int rrDepth() const { return 5; }
 };
 
 // The camera sample (pixel, index) of a tile: its sampler, and the ray through its jittered
@@ -55,5 +69,7 @@ Ray cameraRay(const Scene& scene, int x, int y, Vec2 jitter);
 
 // Adds a finished sample to the film, or counts it in stats.nonFinite if it is NaN or infinite.
 void addToFilm(Film& film, int x, int y, const Color& L, PathStats& stats);
+// The same for sample s of the tile's pass, with the light tracer's splat for it added.
+void addToFilm(Film& film, const TileWork& work, int x, int y, int s, const Color& L, PathStats& stats);
 
 }  // namespace ember

@@ -42,6 +42,9 @@ class Light {
   virtual void sampleLanes(const Vec3* refs, const Vec2* us, size_t n, LightSample* out, bool* ok) const;
 
   int samplerIndex = -1;  // position in the LightSampler's table
+  // Its caustics come from the light tracer (renderer/caustic_tracer.h), which the path tracer
+  // then leaves them to.
+  bool causticTraced = false;
 };
 
 class PointLight final : public Light {
@@ -112,6 +115,10 @@ class AreaLight final : public Light {
   void sampleLanes(const Vec3* refs, const Vec2* us, size_t n, LightSample* out, bool* ok) const override;
   // Lambertian emitter: Phi = pi * A * L per emitting side.
   Color power(float) const override { return (twoSided_ ? 2.0f : 1.0f) * kPi * shape_->area() * radiance_; }
+  const Shape* shape() const { return shape_; }
+  const Color& radiance() const { return radiance_; }
+  bool twoSided() const { return twoSided_; }
+  float pointError() const { return pError_; }  // of the shape's sampled points
 
  private:
   // The light sample from the shape's sample (s, pdf) seen from ref.

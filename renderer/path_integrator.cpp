@@ -96,7 +96,11 @@ bool PathIntegrator::arrive(const Scene& scene, PathState& path, const SurfaceHi
 
   const LightSampler& lights = scene.lightSampler();
   const Color emitted = hit.emitted(wo);
-  if (!isBlack(emitted)) {
+  // Emission after a Dirac bounce, on a path whose first bounce was not one, is a caustic the
+  // light tracer estimates (renderer/caustic_tracer.h): counting it here too would count it twice.
+  const bool caustic = traceCaustics_ && path.previousDelta && path.firstBounceNonDelta && hit.light &&
+                       hit.light->causticTraced;
+  if (!isBlack(emitted) && !caustic) {
     float weight = 1.0f;
     if (!path.previousDelta) {
       const float lightPdf =
@@ -126,6 +130,7 @@ bool PathIntegrator::followBsdfSample(PathState& path, const SurfaceHit& hit, co
   path.previousDelta = bs.delta;
   path.previousPdf = bs.pdf;
   path.previousPoint = hit.p;
+  if (path.depth == 1) path.firstBounceNonDelta = !bs.delta;
   path.etaProduct *= bs.eta;
   path.ray = Ray{hit.offsetOrigin(bs.wi), bs.wi};
 

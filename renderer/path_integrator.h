@@ -39,7 +39,8 @@ struct PathState {
   bool previousDelta = true;  // camera rays count as specular: emitters they see get weight 1
   float previousPdf = 0.0f;
   Vec3 previousPoint{0.0f};
-  int depth = 1;  // segments cast so far, counting the one in flight
+  int depth = 1;                     // segments cast so far, counting the one in flight
+  bool firstBounceNonDelta = false;  // the camera vertex scattered through a non-Dirac lobe
 };
 
 // Next-event estimation's shadow ray: if nothing blocks it, `contribution` (throughput included)
@@ -58,9 +59,16 @@ struct LightPick {
 
 class PathIntegrator final : public Integrator {
  public:
-  PathIntegrator(int maxDepth, int rrDepth, Strategy strategy = Strategy::Mis)
-      : maxDepth_(maxDepth), rrDepth_(rrDepth), strategy_(strategy) {}
-  explicit PathIntegrator(const RenderSettings& s) : PathIntegrator(s.maxDepth, s.rrDepth, s.strategy) {}
+  // traceCaustics: leave the caustic paths of the scene's light tracer to it (render() runs it);
+  // off, the path tracer estimates every path alone, as Li does for a caller outside render().
+  PathIntegrator(int maxDepth, int rrDepth, Strategy strategy = Strategy::Mis, bool traceCaustics = false)
+      : maxDepth_(maxDepth), rrDepth_(rrDepth), strategy_(strategy), traceCaustics_(traceCaustics) {}
+  explicit PathIntegrator(const RenderSettings& s)
+      : PathIntegrator(s.maxDepth, s.rrDepth, s.strategy, s.traceCaustics) {}
+
+  bool tracesCaustics() const override { return traceCaustics_; }
+  int maxDepth() const override { return maxDepth_; }
+  int rrDepth() const override { return rrDepth_; }
 
   // The scalar reference: casts each ray of the path alone, as soon as it is known.
   Color Li(const Scene& scene, Ray ray, Sampler& sampler, PathStats& stats) const override;
@@ -110,6 +118,7 @@ class PathIntegrator final : public Integrator {
   int maxDepth_;
   int rrDepth_;
   Strategy strategy_;
+  bool traceCaustics_;
 };
 
 // The warning to print when `strategy` cannot reach some of a built scene's lights (bsdf and its

@@ -47,6 +47,9 @@ RenderStats render(const Scene& scene, const Integrator& integrator, const Rende
   double lastPass = 0.0;
   const int firstPass = stats.passes;
   tbb::task_arena arena(threads);
+  const bool traceCaustics = integrator.tracesCaustics() && scene.causticTracer().enabled() &&
+                             scene.camera().width() == width && scene.camera().height() == height;
+  CausticSplats splats;
   for (int p = firstPass; p < passes; ++p) {
     // The budget admits a pass if the previous one, run again, would end within it; the first
     // pass of a call always runs, so every render adds at least one.
@@ -61,6 +64,16 @@ RenderStats render(const Scene& scene, const Integrator& integrator, const Rende
     }
     const auto passStart = Clock::now();
     std::fill(rendered.begin(), rendered.end(), 0);
+    const uint64_t passFirstSample = options.firstSample + uint64_t(p) * uint64_t(passSpp);
+    if (traceCaustics) {
+      splats.reset(passSamples(p), width, height);
+      PathStats traced;
+      arena.execute([&] {
+        integrator.traceCaustics(scene, options.seed, options.sampler, passFirstSample, passSamples(p),
+                                 splats, traced);
+      });
+      stats.paths += traced;
+    }
     arena.execute([&] {
       tbb::parallel_for(
           tbb::blocked_range<int>(0, tiles, 1),
@@ -76,10 +89,11 @@ RenderStats render(const Scene& scene, const Integrator& integrator, const Rende
               work.y0 = (t / tilesX) * tile;
               work.x1 = std::min(work.x0 + tile, width);
               work.y1 = std::min(work.y0 + tile, height);
-              work.firstSample = options.firstSample + uint64_t(p) * uint64_t(passSpp);
+              work.firstSample = passFirstSample;
               work.spp = passSamples(p);
               work.seed = options.seed;
               work.sampler = options.sampler;
+              work.caustics = traceCaustics ? &splats : nullptr;
               if (options.stop) film.save(work.x0, work.y0, work.x1, work.y1, backups[size_t(t)]);
               integrator.renderTile(scene, work, film, local);
               rendered[size_t(t)] = 1;

@@ -1,6 +1,37 @@
 #include "renderer/scene.h"
 
+#include "accel/sphere.h"
+
+#include <algorithm>
+#include <cmath>
+
 namespace ember {
+
+namespace {
+
+// A sphere around bounds: the box's centre and half its diagonal.
+CausticCaster boundingSphere(const Bounds& b) {
+  return {0.5f * (b.lower + b.upper), 0.5f * glm::length(b.upper - b.lower)};
+}
+
+}  // namespace
+
+std::vector<CausticCaster> Scene::findCausticCasters() const {
+  // Every surface with a Dirac lobe must be a caster: the light tracer owns the paths whose first
+  // bounce from the light is on one, and aims only at casters.
+  std::vector<CausticCaster> casters;
+  for (const ShapeEntry& entry : shapes) {
+    if (!entry.material || !entry.material->hasDeltaLobes()) continue;
+    if (const auto* sphere = dynamic_cast<const Sphere*>(entry.shape.get()))
+      casters.push_back({sphere->center(), sphere->radius()});
+    else
+      casters.push_back(boundingSphere(entry.shape->bounds()));
+  }
+  for (const MeshEntry& entry : meshes)
+    if (!entry.mesh->indices.empty() && entry.material && entry.material->hasDeltaLobes())
+      casters.push_back(boundingSphere(entry.mesh->bounds()));
+  return casters;
+}
 
 const Material* Scene::addMaterial(std::string name, std::unique_ptr<Material> material) {
   materials.push_back(std::move(material));
@@ -74,6 +105,20 @@ void Scene::build() {
   const float radius = 0.5f * glm::length(bounds_.upper - bounds_.lower);
   lightSampler_ = LightSampler(allLights, radius);
   camera_ = Camera(cameraParams, settings.width, settings.height);
+
+  std::vector<CausticCaster> casters = findCausticCasters();
+  // A caster without finite bounds (a NaN vertex) cannot be aimed at: then none is traced.
+  const bool finite = std::all_of(casters.begin(), casters.end(), [](const CausticCaster& c) {
+    return std::isfinite(c.radius) && std::isfinite(c.center.x) && std::isfinite(c.center.y) &&
+           std::isfinite(c.center.z);
+  });
+  std::vector<const AreaLight*> areaLights;
+  for (const auto& light : lights)
+    if (const auto* area = dynamic_cast<const AreaLight*>(light.get())) areaLights.push_back(area);
+  causticTracer_ = CausticTracer(finite ? std::move(casters) : std::vector<CausticCaster>{},
+                                 std::move(areaLights), camera_.perspective());
+  for (const auto& light : lights)
+    light->causticTraced = causticTracer_.enabled() && dynamic_cast<const AreaLight*>(light.get());
 }
 
 bool Scene::intersect(const Ray& ray, SurfaceHit& hit) const {

@@ -7,6 +7,7 @@
 #include "materials/material.h"
 #include "materials/surface_maps.h"
 #include "renderer/camera.h"
+#include "renderer/caustic_tracer.h"
 #include "renderer/light.h"
 #include "renderer/light_sampler.h"
 #include "renderer/sampler.h"
@@ -28,6 +29,9 @@ struct RenderSettings {
   uint64_t seed = 0;
   SamplerType sampler = SamplerType::Sobol;  // docs/performance.md: lower error at equal time
   Strategy strategy = Strategy::Mis;
+  // Caustics (light through mirrors and glass onto diffuse surfaces) by light tracing
+  // (renderer/caustic_tracer.h) instead of by the path tracer alone.
+  bool traceCaustics = true;
 };
 
 class Scene {
@@ -81,6 +85,9 @@ class Scene {
   const Camera& camera() const { return camera_; }
   const LightSampler& lightSampler() const { return lightSampler_; }
   const EnvironmentLight* environment() const { return environment_; }
+  // The light tracer of the scene's caustics: its casters are the shapes and meshes with a
+  // Dirac lobe, its lights the analytic area lights (renderer/caustic_tracer.h).
+  const CausticTracer& causticTracer() const { return causticTracer_; }
   Bounds bounds() const { return bounds_; }
   const EmbreeAccel& accel() const { return *accel_; }
   size_t triangleCount() const;
@@ -98,6 +105,8 @@ class Scene {
     bool readsUv = true;              // whether the material reads the hit's texture coordinates
   };
 
+  std::vector<CausticCaster> findCausticCasters() const;
+
   std::unique_ptr<EmbreeAccel> accel_;
   std::vector<const Light*> triangleLights_;
   size_t loadedLightCount_ = 0;
@@ -105,6 +114,7 @@ class Scene {
   Camera camera_;
   LightSampler lightSampler_;
   const EnvironmentLight* environment_ = nullptr;
+  CausticTracer causticTracer_;
   Bounds bounds_;
 };
 

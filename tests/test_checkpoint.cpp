@@ -69,6 +69,13 @@ class StopAfterTiles final : public Integrator {
     inner_.renderTile(s, w, f, st);
     if (--left_ <= 0) stop_.store(true);
   }
+  bool tracesCaustics() const override { return inner_.tracesCaustics(); }
+  void traceCaustics(const Scene& s, uint64_t seed, SamplerType sampler, uint64_t first, int count,
+                     CausticSplats& splats, PathStats& st) const override {
+    inner_.traceCaustics(s, seed, sampler, first, count, splats, st);
+  }
+  int maxDepth() const override { return inner_.maxDepth(); }
+  int rrDepth() const override { return inner_.rrDepth(); }
 
  private:
   const Integrator& inner_;

@@ -67,6 +67,7 @@
 #include "materials/mixed.h"
 #include "materials/phong.h"
 #include "materials/texture.h"
+#include "renderer/caustic_tracer.h"
 #include "renderer/light.h"
 #include "renderer/light_sampler.h"
 #include "test_fixtures.h"
@@ -95,7 +96,7 @@ namespace {
 // Parameters of the test as a whole.
 
 constexpr double kAlpha = 0.01;     // family-wise significance level over every case in the file
-constexpr int kNumCases = 66;       // m for the Sidak correction: must equal allCases().size()
+constexpr int kNumCases = 68;       // m for the Sidak correction: must equal allCases().size()
 constexpr long kSamples = 1000000;  // samples per case
 constexpr double kMinExpected = 5.0;
 // Absolute error allowed on integrals of the pdf over the sphere: the midpoint rule on the
@@ -718,6 +719,28 @@ void lightSamplerIndexCase(uint64_t seed) {
 
 // The alias table behind the LightSampler, over many outcomes whose weights span five orders
 // of magnitude, some of them zero: what a scene of thousands of emitters of mixed sizes gives it.
+// The caustic tracer's emission directions (renderer/caustic_tracer.h): a mixture of uniform
+// cones towards casters' bounding spheres, two of them overlapping (a direction in both has the
+// sum of the densities) and, with `inside`, one sphere containing the point (uniform over the
+// sphere). The grid zooms onto the overlapping pair unless the whole sphere is sampled.
+void causticEmissionCase(bool inside, uint64_t seed) {
+  const Vec3 from(0.2f, 1.7f, -0.1f);
+  std::vector<CausticCaster> casters = {{Vec3(0.5f, 0.4f, 0.2f), 0.45f}, {Vec3(0.1f, 0.5f, -0.3f), 0.3f}};
+  if (inside) casters.push_back({from + Vec3(0.1f, -0.2f, 0.05f), 0.5f});
+  const CausticTracer tracer(casters, {}, true);
+  DirectionalCase c;
+  c.grid = inside ? tiltedGrid() : zoomedGrid(from, Vec3(0.3f, 0.45f, -0.05f), 0.75);
+  c.seed = seed;
+  c.sample = [&](Rng& rng, Vec3& w) {
+    const float uPick = rng.uniform();
+    const Vec2 u(rng.uniform(), rng.uniform());
+    w = tracer.sampleDirection(from, uPick, u);
+    return true;
+  };
+  c.pdf = [&](const Vec3& w) { return double(tracer.directionPdf(from, glm::normalize(w))); };
+  runDirectional(c);
+}
+
 void aliasTableCase(uint64_t seed) {
   constexpr size_t kOutcomes = 2000;
   std::vector<double> weights(kOutcomes);
@@ -986,6 +1009,8 @@ const std::vector<Chi2Case>& allCases() {
     add("TriangleLight_directions", triangleLightCase);
     add("TriangleLight_directions_near", triangleLightNearCase);
     add("AreaLightQuad_directions", quadLightCase);
+    add("CausticEmission_overlappingCones", [](uint64_t s) { causticEmissionCase(false, s); });
+    add("CausticEmission_insideOneCaster", [](uint64_t s) { causticEmissionCase(true, s); });
     add("AliasTable_manyOutcomes", aliasTableCase);
     add("LightSampler_index_by_power", lightSamplerIndexCase);
     add("LightSampler_nee_mixture", lightSamplerMixtureCase);

@@ -1,0 +1,143 @@
+// Caustics by light tracing. A caustic is light that leaves an emitter, meets a mirror or glass
+// surface (a Dirac lobe) and then lights a diffuse or glossy surface the camera sees. A path
+// tracer finds such a path only when a BSDF-sampled direction happens to reach the emitter's image
+// in the specular object: rarely, and then very brightly. On cornell-area these paths are 97% of
+// the path tracer's squared error at 64 spp (docs/performance.md). Traced from the light, the
+// same paths are easy: aim at the specular object, follow its Dirac lobe, and connect every
+// diffuse or glossy vertex after it to the camera (Veach 1997, sec. 10.2; PBRT3 sec. 16.3's
+// t = 1 strategy).
+//
+// The two estimators split path space between them, so their sum is unbiased without weights:
+//  - the light tracer takes the paths camera -> x1 ... xk -> emitter whose camera vertex x1 scatters
+//    through a non-Dirac lobe and whose emitter-side vertex xk through a Dirac one, for the area
+//    lights it traces (AreaLight::causticTraced);
+//  - the path tracer takes everything else: it drops emission it reaches after a Dirac bounce when
+//    its first bounce was not a Dirac one (PathIntegrator::arrive).
+// Emission directions are drawn only towards the casters (the shapes and meshes with a Dirac
+// lobe), uniformly in the cones of their bounding spheres: every path the light tracer owns
+// starts with a segment that ends on a caster, so this density covers all of them.
+//
+// Each sample index s gets its own batch of light paths (kPathsPerPixel per pixel), splatted into
+// an image of its own; a pixel's sample s is then the path tracer's sample plus that image's
+// pixel. Samples stay independent across indices, so the film's per-pixel variance (and the
+// z-tests built on it) still holds, and a render is the same for any thread count: each light
+// path has its own sampler, and splats are summed in fixed point, where addition is associative.
+#pragma once
+
+#include "core/alias_table.h"
+#include "core/math.h"
+#include "renderer/sampler.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <memory>
+#include <vector>
+
+namespace ember {
+
+class AreaLight;
+class Scene;
+struct PathStats;
+struct SurfaceHit;
+
+// A caster's bounding sphere.
+struct CausticCaster {
+  Vec3 center;
+  float radius;
+};
+
+// Splat images, one per sample index of a pass, summed in 64-bit fixed point (2^-24 steps, up to
+// 2^39 per pixel) so that the order of the additions cannot change the result.
+class CausticSplats {
+ public:
+  void reset(int indices, int width, int height);
+  int indices() const { return indices_; }
+  // Thread-safe. False (and nothing added) for a non-finite or out-of-range colour.
+  bool add(int index, int x, int y, const Color& c);
+  Color at(int index, int x, int y) const;
+
+ private:
+  static constexpr double kScale = 16777216.0;  // 2^24
+  int indices_ = 0, width_ = 0, height_ = 0;
+  size_t size_ = 0;
+  std::unique_ptr<std::atomic<int64_t>[]> cells_;
+};
+
+class CausticTracer {
+ public:
+  // Scenes with more casters than this are left to the path tracer alone: each emission sample
+  // evaluates every caster's cone.
+  static constexpr size_t kMaxCasters = 64;
+  // Light paths per pixel and sample index.
+  static constexpr float kPathsPerPixel = 1.0f;
+
+  CausticTracer() = default;
+  // Enabled when there are casters (at most kMaxCasters), area lights and a perspective camera.
+  CausticTracer(std::vector<CausticCaster> casters, std::vector<const AreaLight*> lights, bool perspective);
+
+  bool enabled() const { return enabled_; }
+  // Why it does not run, in words ("" when it does).
+  const char* whyDisabled() const { return whyDisabled_; }
+  const std::vector<CausticCaster>& casters() const { return casters_; }
+
+  // Light paths per pixel and sample index, for an image of `pixels` pixels (at least one path),
+  // and the factor each splat is divided by for it.
+  static uint64_t pathCount(uint64_t pixels) {
+    return std::max<uint64_t>(1, uint64_t(std::ceil(double(pixels) * kPathsPerPixel)));
+  }
+
+  // One light path as a state machine, for the scalar driver (traceAlone) and for drivers that
+  // cast the rays of many paths together (packet/caustic_wave.h). Both take the same steps in the
+  // same order per path, so they splat the same values bit for bit.
+  struct PathState {
+    Ray ray;
+    Color beta{0.0f};        // the flux the path carries, over the densities that drew it
+    Color scattering{1.0f};  // the product of the scattering weights (Russian roulette reads it)
+    int segments = 1;        // light segments cast so far, counting the one in flight
+    int index = 0;           // the splat image (sample index within the pass)
+    float pathsPerPixel = 1.0f;
+  };
+  // A connection to the camera: `value` goes to pixel (x, y) if `ray` is unblocked.
+  struct Splat {
+    Ray ray;
+    int x = 0, y = 0;
+    Color value{0.0f};
+  };
+  // The path's emission: false if it carries nothing (its direction leaves the emitting side).
+  bool start(Sampler& sampler, int index, float pathsPerPixel, int maxDepth, PathState& path) const;
+  // The path's ray found `hit`: asks for a camera connection (returns true and fills `splat`)
+  // and samples the next ray into path.ray; `continues` says whether the path goes on.
+  bool onHit(const Scene& scene, int maxDepth, int rrDepth, PathState& path, const SurfaceHit& hit,
+             Sampler& sampler, Splat& splat, bool& continues) const;
+
+  // The light paths of sample indices firstIndex + [0, count) (batch i into splats' image i),
+  // each ray cast alone, counting at most maxDepth segments with the camera's (-1: unbounded).
+  // Runs in parallel on the calling thread's task arena.
+  void traceAlone(const Scene& scene, int maxDepth, int rrDepth, uint64_t seed, SamplerType sampler,
+                  uint64_t firstIndex, int count, CausticSplats& splats, PathStats& stats) const;
+  // The sampler of light path `path` of sample index `sampleIndex`.
+  static Sampler samplerFor(SamplerType type, uint64_t seed, uint64_t path, uint64_t sampleIndex);
+
+  // The emission-direction density from `from` (uniform in the union of the casters' cones, as a
+  // mixture with equal weights), and a direction from it; exposed for the sampling tests.
+  float directionPdf(const Vec3& from, const Vec3& dir) const;
+  Vec3 sampleDirection(const Vec3& from, float uPick, Vec2 u) const;
+
+ private:
+  struct Cone {
+    Vec3 axis;
+    float oneMinusCosMax;  // 2: the whole sphere (from inside the caster's bounds)
+    float sin2Max;
+  };
+  Cone cone(size_t i, const Vec3& from) const;
+
+  std::vector<CausticCaster> casters_;
+  std::vector<const AreaLight*> lights_;
+  AliasTable lightChoice_;  // by power
+  std::vector<float> lightPmf_;
+  bool enabled_ = false;
+  const char* whyDisabled_ = "no mirror or glass";
+};
+
+}  // namespace ember

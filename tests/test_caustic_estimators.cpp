@@ -1,0 +1,205 @@
+// Caustics estimated two ways must agree: the path tracer alone (render.caustic_tracing false)
+// against the path tracer plus the light tracer (renderer/caustic_tracer.h), which split path
+// space between them. Whole small images, block means z-tested from both films' own per-pixel
+// variances (io/image_compare.h), over a planar mirror, a glass sphere (refraction both ways, so
+// the radiance scaling the light tracer must undo), a surface that is both a caster and a
+// receiver (a mixed material with a mirror lobe), a two-sided light, path-length limits that cut
+// the caustics (max depth 3 and 4: the light tracer must count segments as the path tracer does)
+// and every strategy. A last case double-counts the caustics on purpose and must be rejected.
+#include "io/image_compare.h"
+#include "io/scene_loader.h"
+#include "packet/wavefront_integrator.h"
+#include "renderer/render.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace ember {
+namespace {
+
+constexpr int kSize = 24;
+constexpr int kSpp = 512;
+constexpr double kAlpha = 1e-3;  // per comparison; about ten comparisons in this file
+
+// A floor, a back wall and a light 0.8 x 0.8 above them, with `extra` shapes and materials.
+std::string sceneJson(const std::string& extraMaterials, const std::string& extraShapes, int maxDepth,
+                      bool twoSidedLight = false) {
+  return R"({
+    "image": {"width": )" +
+         std::to_string(kSize) + R"(, "height": )" + std::to_string(kSize) + R"(},
+    "camera": {"origin": [0, 1.1, 1.6], "target": [0, 0.5, 0], "up": [0, 1, 0], "fov_y_deg": 90},
+    "render": {"max_depth": )" +
+         std::to_string(maxDepth) + R"(, "rr_depth": 3},
+    "materials": {
+      "white": {"type": "diffuse", "reflectance": [0.8, 0.8, 0.8]},
+      "black": {"type": "diffuse", "reflectance": [0, 0, 0]})" +
+         extraMaterials + R"(
+    },
+    "shapes": [
+      {"type": "quad", "material": "white", "vertices": [[-2, 0, 1.5], [2, 0, 1.5], [2, 0, -1.5], [-2, 0, -1.5]]},
+      {"type": "quad", "material": "white", "vertices": [[-2, 0, -1.5], [2, 0, -1.5], [2, 2.5, -1.5], [-2, 2.5, -1.5]]},
+      {"type": "quad", "material": "black", "emission": [6, 6, 5], "two_sided": )" +
+         std::string(twoSidedLight ? "true" : "false") +
+         R"(, "vertices": [[-0.4, 1.8, -0.6], [0.4, 1.8, -0.6], [0.4, 1.8, 0.2], [-0.4, 1.8, 0.2]]})" +
+         extraShapes + R"(
+    ]
+  })";
+}
+
+// A mirror standing on the floor to the left, facing the light and the floor.
+const std::string kMirrorMaterial = R"(, "mirror": {"type": "mirror", "reflectance": [0.9, 0.9, 0.9]})";
+const std::string kMirrorShape =
+    R"(, {"type": "quad", "material": "mirror", "vertices": [[-1.2, 0, 0.8], [-1.2, 0, -1.2], [-0.9, 1.4, -1.2], [-0.9, 1.4, 0.8]]})";
+const std::string kGlassMaterial =
+    R"(, "glass": {"type": "dielectric", "ior_inside": 1.5, "ior_outside": 1.0})";
+const std::string kGlassShape =
+    R"(, {"type": "sphere", "material": "glass", "center": [0.5, 0.75, -0.2], "radius": 0.4})";
+
+Scene load(const std::string& json, const std::string& name) {
+  const std::string path =
+      (std::filesystem::temp_directory_path() / ("ember_caustics_" + name + ".json")).string();
+  std::ofstream(path) << json;
+  Scene scene = loadScene(path);
+  std::filesystem::remove(path);
+  return scene;
+}
+
+Film render(const Scene& scene, const Integrator& integrator, uint64_t seed) {
+  Film film(scene.settings.width, scene.settings.height);
+  RenderOptions options;
+  options.spp = kSpp;
+  options.seed = seed;
+  options.sampler = scene.settings.sampler;
+  options.threads = 0;
+  render(scene, integrator, options, film);
+  return film;
+}
+
+// The path tracer leaves caustics to the light tracer, or does not: the films of both.
+struct Pair {
+  Film lightTraced, pathOnly;
+};
+
+Pair renderBoth(Scene& scene) {
+  scene.settings.traceCaustics = true;
+  scene.build();
+  EXPECT_TRUE(scene.causticTracer().enabled());
+  Film traced = render(scene, *makeIntegrator(scene.settings, Kernel::Wavefront), 11);
+  scene.settings.traceCaustics = false;
+  Film alone = render(scene, *makeIntegrator(scene.settings, Kernel::Wavefront), 12);
+  return {std::move(traced), std::move(alone)};
+}
+
+BlockZTestResult compare(const Film& a, const Film& b) {
+  return blockZTest(a.mean(), a.varianceOfMean(), b.mean(), b.varianceOfMean(), 4, kAlpha);
+}
+
+void expectAgree(Scene scene, const std::string& what) {
+  const Pair p = renderBoth(scene);
+  const BlockZTestResult r = compare(p.lightTraced, p.pathOnly);
+  EXPECT_TRUE(r.passes()) << what << ": " << r.failures << " of " << r.tests
+                          << " block means differ (max |z| " << r.maxAbsZ << ", threshold " << r.threshold
+                          << "), image-mean z " << r.meanZ[0] << " " << r.meanZ[1] << " " << r.meanZ[2];
+}
+
+TEST(CausticEstimators, PlanarMirrorAgreesWithThePathTracerAlone) {
+  expectAgree(load(sceneJson(kMirrorMaterial, kMirrorShape, -1), "mirror"), "mirror");
+}
+
+// All the light the floor gets is a caustic: the light faces up, into a mirror ceiling. Seen
+// through a 100-degree lens, so that the camera's importance (1 / cos^3 per splat) is tested
+// far off the axis as well.
+TEST(CausticEstimators, LightOnlyThroughAMirrorAgreesAcrossAWideView) {
+  const std::string json = R"({
+    "image": {"width": 24, "height": 24},
+    "camera": {"origin": [0, 0.9, 1.4], "target": [0, 0.2, -0.2], "up": [0, 1, 0], "fov_y_deg": 100},
+    "render": {"max_depth": -1, "rr_depth": 3},
+    "materials": {
+      "white": {"type": "diffuse", "reflectance": [0.7, 0.7, 0.7]},
+      "black": {"type": "diffuse", "reflectance": [0, 0, 0]},
+      "mirror": {"type": "mirror", "reflectance": [0.95, 0.95, 0.95]}
+    },
+    "shapes": [
+      {"type": "quad", "material": "white", "vertices": [[-3, 0, 2], [3, 0, 2], [3, 0, -3], [-3, 0, -3]]},
+      {"type": "quad", "material": "mirror", "vertices": [[-3, 2, -3], [3, 2, -3], [3, 2, 2], [-3, 2, 2]]},
+      {"type": "quad", "material": "black", "emission": [5, 5, 5],
+       "vertices": [[-0.5, 1.2, 0.3], [0.5, 1.2, 0.3], [0.5, 1.2, -0.7], [-0.5, 1.2, -0.7]]}
+    ]
+  })";
+  expectAgree(load(json, "mirror-only"), "light only through a mirror");
+}
+
+TEST(CausticEstimators, GlassSphereAgreesWithThePathTracerAlone) {
+  expectAgree(load(sceneJson(kGlassMaterial, kGlassShape, -1), "glass"), "glass");
+}
+
+TEST(CausticEstimators, TwoSidedLightAndBothCastersAgree) {
+  expectAgree(load(sceneJson(kMirrorMaterial + kGlassMaterial, kMirrorShape + kGlassShape, -1, true), "both"),
+              "two-sided light, mirror and glass");
+}
+
+// The floor reflects through a mirror lobe as well as diffusely: one surface is caster and
+// receiver, and a light path may bounce between its two lobes.
+TEST(CausticEstimators, MixedMaterialCasterAndReceiverAgrees) {
+  const std::string mixed =
+      R"(, "shiny": {"type": "mixed", "kd": [0.4, 0.4, 0.4], "kr": [0.35, 0.35, 0.35]})";
+  const std::string shinyBox =
+      R"(, {"type": "box", "material": "shiny", "center": [-0.5, 0.3, -0.4], "size": [0.6, 0.6, 0.6], "rotate_y_deg": 25})";
+  expectAgree(load(sceneJson(mixed + kMirrorMaterial, shinyBox + kMirrorShape, -1), "mixed"), "mixed");
+}
+
+TEST(CausticEstimators, PathLengthLimitsCutBothAlike) {
+  for (int depth : {3, 4}) {
+    expectAgree(load(sceneJson(kMirrorMaterial + kGlassMaterial, kMirrorShape + kGlassShape, depth),
+                     "depth" + std::to_string(depth)),
+                "max depth " + std::to_string(depth));
+  }
+}
+
+TEST(CausticEstimators, EveryStrategyAgrees) {
+  for (Strategy strategy : {Strategy::Bsdf, Strategy::Light}) {
+    Scene scene = load(sceneJson(kMirrorMaterial, kMirrorShape, -1), "strategy");
+    scene.settings.strategy = strategy;
+    expectAgree(std::move(scene), std::string(strategyName(strategy)));
+  }
+}
+
+// Light tracing with a path tracer that does not leave it the caustics counts them twice: the
+// comparison must see it (so it can fail), and the caustic must be a large share of the image.
+class DoubleCounting final : public Integrator {
+ public:
+  explicit DoubleCounting(const RenderSettings& s) : inner_(s) {}
+  Color Li(const Scene& s, Ray r, Sampler& smp, PathStats& st) const override {
+    return inner_.Li(s, r, smp, st);
+  }
+  void renderTile(const Scene& s, const TileWork& w, Film& f, PathStats& st) const override {
+    inner_.renderTile(s, w, f, st);
+  }
+  bool tracesCaustics() const override { return true; }
+  void traceCaustics(const Scene& s, uint64_t seed, SamplerType sampler, uint64_t first, int count,
+                     CausticSplats& splats, PathStats& st) const override {
+    inner_.traceCaustics(s, seed, sampler, first, count, splats, st);
+  }
+  int maxDepth() const override { return inner_.maxDepth(); }
+  int rrDepth() const override { return inner_.rrDepth(); }
+
+ private:
+  WavefrontIntegrator inner_;
+};
+
+TEST(CausticEstimators, DoubleCountedCausticsAreRejected) {
+  Scene scene = load(sceneJson(kMirrorMaterial + kGlassMaterial, kMirrorShape + kGlassShape, -1), "double");
+  scene.settings.traceCaustics = false;  // the inner path tracer keeps every path
+  scene.build();
+  const Film twice = render(scene, DoubleCounting(scene.settings), 11);
+  const Film alone = render(scene, *makeIntegrator(scene.settings, Kernel::Wavefront), 12);
+  const BlockZTestResult r = compare(twice, alone);
+  EXPECT_FALSE(r.passes());
+  EXPECT_GT(r.failures, r.tests / 10) << "caustics should be visible in many blocks";
+}
+
+}  // namespace
+}  // namespace ember
