@@ -3,7 +3,8 @@
 #include "accel/shape.h"
 
 #include <algorithm>
-#include <cmath>
+#include <bit>
+#include <cstdint>
 
 namespace ember {
 
@@ -100,6 +101,11 @@ void intersectPacket(const Shape& shape, bool needsUv, RTCRayN* rays, unsigned n
   }
 }
 
+// The next float above a ray's tfar (which is positive, or +infinity, which stays).
+inline float nextFloatUp(float x) {
+  return x < kInfinity ? std::bit_cast<float>(std::bit_cast<uint32_t>(x) + 1u) : x;
+}
+
 void shapeIntersectCallback(const RTCIntersectFunctionNArguments* args) {
   const auto* geometry = static_cast<const ShapeGeometry*>(args->geometryUserPtr);
   RTCRayN* rays = RTCRayHitN_RayN(args->rayhit, args->N);
@@ -112,7 +118,7 @@ void shapeIntersectCallback(const RTCIntersectFunctionNArguments* args) {
   float tfar[RayLanes::kMaxLanes];  // Embree calls with packets of 16 or single rays (PacketLanes)
   for (unsigned i = 0; i < n; ++i) {
     tfar[i] = RTCRayN_tfar(rays, n, i);
-    if (args->valid[i]) RTCRayN_tfar(rays, n, i) = std::nextafter(tfar[i], kInfinity);
+    if (args->valid[i]) RTCRayN_tfar(rays, n, i) = nextFloatUp(tfar[i]);
   }
   intersectPacket(*geometry->shape, geometry->needsUv, rays, n, args->valid,
                   [&](unsigned i, const LocalHit& h) {

@@ -86,8 +86,8 @@ class JsonSceneLoader {
   }
 
   void readRender(const JsonNode& n) {
-    n.allowKeys(
-        {"spp", "max_depth", "rr_depth", "seed", "background", "sampler", "strategy", "caustic_tracing"});
+    n.allowKeys({"spp", "max_depth", "rr_depth", "seed", "background", "sampler", "strategy",
+                 "caustic_tracing", "caustic_paths_per_pixel"});
     RenderSettings& s = scene_.settings;
     if (n.has("spp")) s.spp = n.at("spp").integer(1, 1 << 24);
     if (n.has("max_depth")) s.maxDepth = n.at("max_depth").integer(-1, 100000);
@@ -109,6 +109,10 @@ class JsonSceneLoader {
       s.strategy = *parsed;
     }
     s.traceCaustics = n.boolean("caustic_tracing", s.traceCaustics);
+    if (auto paths = n.find("caustic_paths_per_pixel")) {
+      s.causticPathsPerPixel = paths->positive();
+      if (s.causticPathsPerPixel > 64.0f) paths->fail("must be at most 64");
+    }
     scene_.background = n.color("background", Color(0.0f));
   }
 

@@ -45,7 +45,7 @@ void traceCausticsInWaves(const Scene& scene, int maxDepth, int rrDepth, uint64_
   const CausticTracer& tracer = scene.causticTracer();
   if (!tracer.enabled() || count <= 0) return;
   const uint64_t pixels = uint64_t(scene.camera().width()) * uint64_t(scene.camera().height());
-  const uint64_t paths = CausticTracer::pathCount(pixels);
+  const uint64_t paths = tracer.pathCount(pixels);
   const float pathsPerPixel = float(double(paths) / double(pixels));
   std::mutex statsMutex;
   tbb::parallel_for(

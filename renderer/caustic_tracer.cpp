@@ -53,8 +53,11 @@ bool CausticSplats::add(int index, int x, int y, const Color& c) {
   for (int k = 0; k < 3; ++k)
     if (!(std::abs(double(c[k])) < kLimit)) return false;
   const size_t i = ((size_t(index) * size_t(height_) + size_t(y)) * size_t(width_) + size_t(x)) * 3;
-  for (int k = 0; k < 3; ++k)
-    cells_[i + size_t(k)].fetch_add(std::llround(double(c[k]) * kScale), std::memory_order_relaxed);
+  for (int k = 0; k < 3; ++k) {
+    // Rounded half away from zero by truncating: a conversion instruction, where llround is a call.
+    const double scaled = double(c[k]) * kScale;
+    cells_[i + size_t(k)].fetch_add(int64_t(scaled + std::copysign(0.5, scaled)), std::memory_order_relaxed);
+  }
   return true;
 }
 
@@ -67,8 +70,8 @@ Color CausticSplats::at(int index, int x, int y) const {
 }
 
 CausticTracer::CausticTracer(std::vector<CausticCaster> casters, std::vector<const AreaLight*> lights,
-                             bool perspective)
-    : casters_(std::move(casters)), lights_(std::move(lights)) {
+                             bool perspective, float pathsPerPixel)
+    : casters_(std::move(casters)), lights_(std::move(lights)), pathsPerPixel_(pathsPerPixel) {
   whyDisabled_ = casters_.empty()                ? "no mirror or glass"
                  : casters_.size() > kMaxCasters ? "more specular objects than it aims at (64)"
                  : lights_.empty()               ? "no area light to trace from"

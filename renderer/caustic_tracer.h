@@ -17,7 +17,8 @@
 // lobe), uniformly in the cones of their bounding spheres: every path the light tracer owns
 // starts with a segment that ends on a caster, so this density covers all of them.
 //
-// Each sample index s gets its own batch of light paths (kPathsPerPixel per pixel), splatted into
+// Each sample index s gets its own batch of light paths (render.caustic_paths_per_pixel times the
+// pixel count), splatted into
 // an image of its own; a pixel's sample s is then the path tracer's sample plus that image's
 // pixel. Samples stay independent across indices, so the film's per-pixel variance (and the
 // z-tests built on it) still holds, and a render is the same for any thread count: each light
@@ -69,22 +70,19 @@ class CausticTracer {
   // Scenes with more casters than this are left to the path tracer alone: each emission sample
   // evaluates every caster's cone.
   static constexpr size_t kMaxCasters = 64;
-  // Light paths per pixel and sample index.
-  static constexpr float kPathsPerPixel = 1.0f;
-
   CausticTracer() = default;
   // Enabled when there are casters (at most kMaxCasters), area lights and a perspective camera.
-  CausticTracer(std::vector<CausticCaster> casters, std::vector<const AreaLight*> lights, bool perspective);
+  CausticTracer(std::vector<CausticCaster> casters, std::vector<const AreaLight*> lights, bool perspective,
+                float pathsPerPixel = 0.5f);
 
   bool enabled() const { return enabled_; }
   // Why it does not run, in words ("" when it does).
   const char* whyDisabled() const { return whyDisabled_; }
   const std::vector<CausticCaster>& casters() const { return casters_; }
 
-  // Light paths per pixel and sample index, for an image of `pixels` pixels (at least one path),
-  // and the factor each splat is divided by for it.
-  static uint64_t pathCount(uint64_t pixels) {
-    return std::max<uint64_t>(1, uint64_t(std::ceil(double(pixels) * kPathsPerPixel)));
+  // Light paths per sample index for an image of `pixels` pixels (at least one).
+  uint64_t pathCount(uint64_t pixels) const {
+    return std::max<uint64_t>(1, uint64_t(std::ceil(double(pixels) * double(pathsPerPixel_))));
   }
 
   // One light path as a state machine, for the scalar driver (traceAlone) and for drivers that
@@ -136,6 +134,7 @@ class CausticTracer {
   std::vector<const AreaLight*> lights_;
   AliasTable lightChoice_;  // by power
   std::vector<float> lightPmf_;
+  float pathsPerPixel_ = 0.5f;
   bool enabled_ = false;
   const char* whyDisabled_ = "no mirror or glass";
 };

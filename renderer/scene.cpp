@@ -116,7 +116,7 @@ void Scene::build() {
   for (const auto& light : lights)
     if (const auto* area = dynamic_cast<const AreaLight*>(light.get())) areaLights.push_back(area);
   causticTracer_ = CausticTracer(finite ? std::move(casters) : std::vector<CausticCaster>{},
-                                 std::move(areaLights), camera_.perspective());
+                                 std::move(areaLights), camera_.perspective(), settings.causticPathsPerPixel);
   for (const auto& light : lights)
     light->causticTraced = causticTracer_.enabled() && dynamic_cast<const AreaLight*>(light.get());
 }

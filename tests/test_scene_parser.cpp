@@ -69,6 +69,12 @@ TEST(SceneParser, BadInputNamesFileAndPath) {
       {"unknown strategy", variant("\"spp\": 2", "\"spp\": 2, \"strategy\": \"bidir\""),
        "render.strategy: unknown strategy 'bidir'; valid: mis, bsdf, light"},
       {"strategy not a string", variant("\"spp\": 2", "\"spp\": 2, \"strategy\": 1"), "render.strategy"},
+      {"caustic tracing not a boolean", variant("\"spp\": 2", "\"spp\": 2, \"caustic_tracing\": \"yes\""),
+       "render.caustic_tracing"},
+      {"negative caustic paths", variant("\"spp\": 2", "\"spp\": 2, \"caustic_paths_per_pixel\": -1"),
+       "render.caustic_paths_per_pixel"},
+      {"too many caustic paths", variant("\"spp\": 2", "\"spp\": 2, \"caustic_paths_per_pixel\": 65"),
+       "render.caustic_paths_per_pixel: must be at most 64"},
       {"unknown top-level key", variant("\"render\"", "\"rendr\""),
        "rendr: unknown key; valid keys here are: image, camera, render"},
       {"unknown material", variant("\"material\": \"white\"}", "\"material\": \"snow\"}"),
@@ -171,11 +177,27 @@ TEST(CommandLine, BadArgumentsExitNonZero) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("m.png")));
   EXPECT_NE(test::runEmber("render '" + scene + "' -o '" + dir.file("x.exr") + "' --strategy bidir").exitCode,
             0);
+  EXPECT_NE(
+      test::runEmber("render '" + scene + "' -o '" + dir.file("x.exr") + "' --caustics photons").exitCode, 0);
   EXPECT_FALSE(std::filesystem::exists(dir.file("x.exr")));
   const auto help = test::runEmber("render --help");
   EXPECT_EQ(help.exitCode, 0);
   EXPECT_NE(help.output.find("--first-sample"), std::string::npos);
   EXPECT_NE(help.output.find("--strategy"), std::string::npos);
+  EXPECT_NE(help.output.find("--caustics"), std::string::npos);
+}
+
+// ember info says how caustics are estimated, and why not by light tracing when it is not.
+TEST(CommandLine, InfoSaysHowCausticsAreEstimated) {
+  const auto area = test::runEmber("info '" + test::sourcePath("scenes/cornell-area.json") + "'");
+  EXPECT_NE(area.output.find("caustics:   light-traced, 2 specular object(s)"), std::string::npos)
+      << area.output;
+  const auto point = test::runEmber("info '" + test::sourcePath("scenes/cornell-point.json") + "'");
+  EXPECT_NE(point.output.find("caustics:   path-traced (no area light to trace from)"), std::string::npos)
+      << point.output;
+  const auto shapes = test::runEmber("info '" + test::sourcePath("scenes/shapes.json") + "'");
+  EXPECT_NE(shapes.output.find("caustics:   path-traced (no mirror or glass)"), std::string::npos)
+      << shapes.output;
 }
 
 // --strategy bsdf cannot reach the scene's point light, and says so; the others are silent.
