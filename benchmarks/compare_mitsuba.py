@@ -12,6 +12,7 @@ Prints a Markdown table (the one quoted in docs/performance.md). Ember's seconds
 loop's, which it prints; Mitsuba's are those of mi.render after a warm-up render has compiled its
 kernels. Both thus leave out process start, scene loading and image output."""
 import argparse
+import itertools
 import json
 import os
 import re
@@ -32,21 +33,23 @@ def relmse(img, ref):
     return float(np.mean((img - ref) ** 2 / (ref ** 2 + 0.01)))
 
 
-def render_ember(ember, scene, spp, seed, threads, out, sampler, kernel):
+def render_ember(ember, scene, spp, seed, threads, out, sampler, kernel, caustics):
     """The image, the render loop's seconds (as Ember reports them: without process start, scene
     load and EXR write, like Mitsuba's timing of mi.render after its JIT warm-up) and the wall
     seconds of the whole process."""
     t = time.perf_counter()
     run = subprocess.run([ember, "render", scene, "-o", out, "--spp", str(spp), "--seed", str(seed),
-                          "--threads", str(threads), "--sampler", sampler, "--kernel", kernel, "-q"],
+                          "--threads", str(threads), "--sampler", sampler, "--kernel", kernel,
+                          "--caustics", caustics, "-q"],
                          check=True, stderr=subprocess.PIPE, text=True)
     wall = time.perf_counter() - t
     loop = float(re.search(r"render ([0-9.]+) s", run.stderr).group(1))
     return load_exr(out), loop, wall
 
 
-def ember_column(kernel, sampler):
-    return f"ember-{sampler}" if kernel == "wavefront" else f"ember-{kernel}-{sampler}"
+def ember_column(kernel, sampler, caustics):
+    name = f"ember-{sampler}" if kernel == "wavefront" else f"ember-{kernel}-{sampler}"
+    return name if caustics == "trace" else name + "-pathcaustics"
 
 
 def main():
@@ -57,6 +60,8 @@ def main():
     ap.add_argument("--variants", nargs="*", default=["llvm_ad_rgb"])
     ap.add_argument("--samplers", nargs="*", default=["independent", "sobol"], help="Ember samplers to run")
     ap.add_argument("--kernels", nargs="*", default=["wavefront"], help="Ember kernels to run (--kernel)")
+    ap.add_argument("--caustics", nargs="*", default=["trace"],
+                    help="Ember caustics estimators to run (--caustics trace: light tracing, path: path tracing alone)")
     ap.add_argument("--threads", type=int, default=os.cpu_count())
     ap.add_argument("--ember", default=os.path.join(ROOT, "build", "app", "ember"))
     ap.add_argument("--json", help="also write the raw numbers here")
@@ -72,18 +77,18 @@ def main():
         spec = os.path.join(ROOT, "tests", "data", name, "scene.json")
         for spp in args.spp:
             row = {"scene": name, "spp": spp}
-            for kernel in args.kernels:
-                for sampler in args.samplers:
-                    errs, times, walls = [], [], []
-                    for s in range(args.seeds):
-                        img, dt, wall = render_ember(args.ember, os.path.join(ROOT, "scenes", name + ".json"), spp,
-                                                     100 + s, args.threads, os.path.join(tmp, "e.exr"), sampler, kernel)
-                        errs.append(relmse(img, ref))
-                        times.append(dt)
-                        walls.append(wall)
-                    row[ember_column(kernel, sampler)] = {"relmse": float(np.mean(errs)),
-                                                          "seconds": float(np.mean(times)),
-                                                          "wall_seconds": float(np.mean(walls))}
+            for kernel, sampler, caustics in itertools.product(args.kernels, args.samplers, args.caustics):
+                errs, times, walls = [], [], []
+                for s in range(args.seeds):
+                    img, dt, wall = render_ember(args.ember, os.path.join(ROOT, "scenes", name + ".json"), spp,
+                                                 100 + s, args.threads, os.path.join(tmp, "e.exr"), sampler, kernel,
+                                                 caustics)
+                    errs.append(relmse(img, ref))
+                    times.append(dt)
+                    walls.append(wall)
+                row[ember_column(kernel, sampler, caustics)] = {"relmse": float(np.mean(errs)),
+                                                                "seconds": float(np.mean(times)),
+                                                                "wall_seconds": float(np.mean(walls))}
             for variant in args.variants:
                 mi.set_variant(variant)
                 mi.set_log_level(mi.LogLevel.Error)
@@ -101,7 +106,8 @@ def main():
             print(json.dumps(row), file=sys.stderr, flush=True)
 
     pixels = 256 * 256
-    cols = [ember_column(k, s) for k in args.kernels for s in args.samplers] + args.variants
+    cols = [ember_column(k, s, c) for k, s, c in itertools.product(args.kernels, args.samplers, args.caustics)]
+    cols += args.variants
     base = args.variants[0]
     head = "| scene | spp | " + " | ".join(f"{c} relMSE" for c in cols) + " | " + \
            " | ".join(f"{c} Msamples/s" for c in cols) + " | " + \
