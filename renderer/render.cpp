@@ -15,6 +15,8 @@
 #include <atomic>
 #include <chrono>
 #include <mutex>
+#include <stdexcept>
+#include <string>
 
 namespace ember {
 
@@ -47,8 +49,13 @@ RenderStats render(const Scene& scene, const Integrator& integrator, const Rende
   double lastPass = 0.0;
   const int firstPass = stats.passes;
   tbb::task_arena arena(threads);
-  const bool traceCaustics = integrator.tracesCaustics() && scene.causticTracer().enabled() &&
-                             scene.camera().width() == width && scene.camera().height() == height;
+  const bool traceCaustics = integrator.tracesCaustics() && scene.causticTracer().enabled();
+  // The light tracer splats where the camera projects, and the path tracer has left it the
+  // caustics: a film of another size would lose them (a caller's error, never the CLI's).
+  if (traceCaustics && (scene.camera().width() != width || scene.camera().height() != height))
+    throw std::invalid_argument("render: the film is " + std::to_string(width) + "x" + std::to_string(height) +
+                                " but the scene was built for " + std::to_string(scene.camera().width()) + "x" +
+                                std::to_string(scene.camera().height()));
   CausticSplats splats;
   for (int p = firstPass; p < passes; ++p) {
     // The budget admits a pass if the previous one, run again, would end within it; the first
