@@ -53,8 +53,9 @@ RenderStats render(const Scene& scene, const Integrator& integrator, const Rende
   // The light tracer splats where the camera projects, and the path tracer has left it the
   // caustics: a film of another size would lose them (a caller's error, never the CLI's).
   if (traceCaustics && (scene.camera().width() != width || scene.camera().height() != height))
-    throw std::invalid_argument("render: the film is " + std::to_string(width) + "x" + std::to_string(height) +
-                                " but the scene was built for " + std::to_string(scene.camera().width()) + "x" +
+    throw std::invalid_argument("render: the film is " + std::to_string(width) + "x" +
+                                std::to_string(height) + " but the scene was built for " +
+                                std::to_string(scene.camera().width()) + "x" +
                                 std::to_string(scene.camera().height()));
   CausticSplats splats;
   for (int p = firstPass; p < passes; ++p) {
