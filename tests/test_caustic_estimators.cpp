@@ -13,6 +13,8 @@
 
 #include <gtest/gtest.h>
 
+#include "test_fixtures.h"
+
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -169,32 +171,18 @@ TEST(CausticEstimators, EveryStrategyAgrees) {
 
 // Light tracing with a path tracer that does not leave it the caustics counts them twice: the
 // comparison must see it (so it can fail), and the caustic must be a large share of the image.
-class DoubleCounting final : public Integrator {
+class DoubleCounting final : public test::ForwardingIntegrator {
  public:
-  explicit DoubleCounting(const RenderSettings& s) : inner_(s) {}
-  Color Li(const Scene& s, Ray r, Sampler& smp, PathStats& st) const override {
-    return inner_.Li(s, r, smp, st);
-  }
-  void renderTile(const Scene& s, const TileWork& w, Film& f, PathStats& st) const override {
-    inner_.renderTile(s, w, f, st);
-  }
+  explicit DoubleCounting(const Integrator& inner) : ForwardingIntegrator(inner) {}
   bool tracesCaustics() const override { return true; }
-  void traceCaustics(const Scene& s, uint64_t seed, SamplerType sampler, uint64_t first, int count,
-                     CausticSplats& splats, PathStats& st) const override {
-    inner_.traceCaustics(s, seed, sampler, first, count, splats, st);
-  }
-  int maxDepth() const override { return inner_.maxDepth(); }
-  int rrDepth() const override { return inner_.rrDepth(); }
-
- private:
-  WavefrontIntegrator inner_;
 };
 
 TEST(CausticEstimators, DoubleCountedCausticsAreRejected) {
   Scene scene = load(sceneJson(kMirrorMaterial + kGlassMaterial, kMirrorShape + kGlassShape, -1), "double");
   scene.settings.traceCaustics = false;  // the inner path tracer keeps every path
   scene.build();
-  const Film twice = render(scene, DoubleCounting(scene.settings), 11);
+  const std::unique_ptr<Integrator> pathOnly = makeIntegrator(scene.settings, Kernel::Wavefront);
+  const Film twice = render(scene, DoubleCounting(*pathOnly), 11);
   const Film alone = render(scene, *makeIntegrator(scene.settings, Kernel::Wavefront), 12);
   const BlockZTestResult r = compare(twice, alone);
   EXPECT_FALSE(r.passes());

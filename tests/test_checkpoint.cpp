@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "cli_runner.h"
+#include "test_fixtures.h"
 #include "test_paths.h"
 
 #include <signal.h>
@@ -58,27 +59,16 @@ bool sameImage(const Image& a, const Image& b) {
 }
 
 // An integrator that raises the stop flag after a number of tiles, from inside a pass.
-class StopAfterTiles final : public Integrator {
+class StopAfterTiles final : public test::ForwardingIntegrator {
  public:
   StopAfterTiles(const Integrator& inner, std::atomic<bool>& stop, int tiles)
-      : inner_(inner), stop_(stop), left_(tiles) {}
-  Color Li(const Scene& s, Ray r, Sampler& smp, PathStats& st) const override {
-    return inner_.Li(s, r, smp, st);
-  }
+      : ForwardingIntegrator(inner), stop_(stop), left_(tiles) {}
   void renderTile(const Scene& s, const TileWork& w, Film& f, PathStats& st) const override {
-    inner_.renderTile(s, w, f, st);
+    ForwardingIntegrator::renderTile(s, w, f, st);
     if (--left_ <= 0) stop_.store(true);
   }
-  bool tracesCaustics() const override { return inner_.tracesCaustics(); }
-  void traceCaustics(const Scene& s, uint64_t seed, SamplerType sampler, uint64_t first, int count,
-                     CausticSplats& splats, PathStats& st) const override {
-    inner_.traceCaustics(s, seed, sampler, first, count, splats, st);
-  }
-  int maxDepth() const override { return inner_.maxDepth(); }
-  int rrDepth() const override { return inner_.rrDepth(); }
 
  private:
-  const Integrator& inner_;
   std::atomic<bool>& stop_;
   mutable std::atomic<int> left_;
 };

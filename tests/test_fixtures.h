@@ -17,6 +17,29 @@ inline SurfaceHit flatHit() {
   return hit;
 }
 
+// An integrator that hands every call to another, for tests that wrap one to watch or change a
+// single step: they override only that.
+class ForwardingIntegrator : public Integrator {
+ public:
+  explicit ForwardingIntegrator(const Integrator& inner) : inner_(inner) {}
+  Color Li(const Scene& s, Ray r, Sampler& smp, PathStats& st) const override {
+    return inner_.Li(s, r, smp, st);
+  }
+  void renderTile(const Scene& s, const TileWork& w, Film& f, PathStats& st) const override {
+    inner_.renderTile(s, w, f, st);
+  }
+  bool tracesCaustics() const override { return inner_.tracesCaustics(); }
+  void traceCaustics(const Scene& s, uint64_t seed, SamplerType sampler, uint64_t first, int count,
+                     CausticSplats& splats, PathStats& st) const override {
+    inner_.traceCaustics(s, seed, sampler, first, count, splats, st);
+  }
+  int maxDepth() const override { return inner_.maxDepth(); }
+  int rrDepth() const override { return inner_.rrDepth(); }
+
+ private:
+  const Integrator& inner_;
+};
+
 // Renders a built scene at its own image size and depth settings, with the kernel `ember render`
 // uses by default (tests/test_wavefront.cpp holds it equal to the scalar reference).
 inline Film renderFilm(const Scene& scene, int spp, uint64_t seed, RenderStats* stats = nullptr,
