@@ -16,7 +16,13 @@ mkdir -p "$corpus"/{scene_json,gltf,checkpoint}
 # assimp-testmodels, the generated showcases, the Khronos samples beside a checkout); a real
 # checkpoint. Copied, so the fuzzer's new inputs never land in the source tree.
 cp scenes/*.json "$corpus/scene_json/"
-find scenes/gltf /usr/share/assimp/models/glTF2 ../shared/assets/gltf \( -name '*.gltf' -o -name '*.glb' \) \
+# Only the folders that exist: find fails on a missing one, and pipefail would end the run (a clone
+# without ../shared beside it).
+seed_dirs=()
+for d in scenes/gltf /usr/share/assimp/models/glTF2 ../shared/assets/gltf; do
+  if [ -d "$d" ]; then seed_dirs+=("$d"); fi
+done
+find "${seed_dirs[@]}" \( -name '*.gltf' -o -name '*.glb' \) \
   -size -2M 2>/dev/null | while read -r f; do cp "$f" "$corpus/gltf/$(echo "$f" | md5sum | cut -c1-16)$(basename "$f" | sed 's/.*\(\.gl[tb]f*\)$/\1/')"; done
 ASAN_OPTIONS=detect_leaks=0 build-fuzz/app/ember render scenes/cornell-area.json -o "$corpus/seed.exr" --width 8 \
   --height 6 --spp 2 -q --checkpoint "$corpus/checkpoint/seed.ckpt" 2>/dev/null
