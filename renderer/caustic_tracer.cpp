@@ -48,8 +48,9 @@ void CausticSplats::reset(int indices, int width, int height) {
 }
 
 bool CausticSplats::add(int index, int x, int y, const Color& c) {
-  // 2^62 / 2^24 = 2^38 per splat leaves room for a few splats of that size in a pixel.
-  constexpr double kLimit = 274877906944.0;  // 2^38
+  // At most 2^32 per splat (2^56 in fixed point): a pixel holds 2^7 of the largest before its
+  // 64-bit sum could wrap. A light path's splat that large is a non-finite sample in all but name.
+  constexpr double kLimit = 4294967296.0;  // 2^32
   for (int k = 0; k < 3; ++k)
     if (!(std::abs(double(c[k])) < kLimit)) return false;
   const size_t i = ((size_t(index) * size_t(height_) + size_t(y)) * size_t(width_) + size_t(x)) * 3;

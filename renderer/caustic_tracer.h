@@ -49,7 +49,8 @@ struct CausticCaster {
 };
 
 // Splat images, one per sample index of a pass, summed in 64-bit fixed point (2^-24 steps, up to
-// 2^39 per pixel) so that the order of the additions cannot change the result.
+// 2^39 per pixel; one splat at most 2^32) so that the order of the additions cannot change the
+// result.
 class CausticSplats {
  public:
   void reset(int indices, int width, int height);

@@ -79,6 +79,7 @@ TEST(CausticSplats, RefusesNonFiniteAndHugeValues) {
   EXPECT_FALSE(s.add(0, 0, 0, Color(inf, 0.0f, 0.0f)));
   EXPECT_FALSE(s.add(0, 0, 0, Color(0.0f, nan, 0.0f)));
   EXPECT_FALSE(s.add(0, 0, 0, Color(0.0f, 0.0f, 1e30f)));
+  EXPECT_FALSE(s.add(0, 0, 0, Color(0.0f, 0.0f, 5e9f)));  // above 2^32: its pixel could wrap
   EXPECT_EQ(s.at(0, 0, 0), Color(0.0f));
   EXPECT_TRUE(s.add(0, 0, 0, Color(-1.5f, 0.25f, 3.0f)));
   EXPECT_EQ(s.at(0, 0, 0), Color(-1.5f, 0.25f, 3.0f));  // exact in 2^-24 steps
