@@ -44,9 +44,7 @@ void traceCausticsInWaves(const Scene& scene, int maxDepth, int rrDepth, uint64_
                           BatchTraversal traversal) {
   const CausticTracer& tracer = scene.causticTracer();
   if (!tracer.enabled() || count <= 0) return;
-  const uint64_t pixels = uint64_t(scene.camera().width()) * uint64_t(scene.camera().height());
-  const uint64_t paths = tracer.pathCount(pixels);
-  const float pathsPerPixel = float(double(paths) / double(pixels));
+  const auto [paths, pathsPerPixel] = tracer.batchFor(scene.camera());
   std::mutex statsMutex;
   tbb::parallel_for(
       tbb::blocked_range<uint64_t>(0, paths * uint64_t(count), LightWave::kSize),

@@ -37,10 +37,11 @@ float shadingCorrection(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) {
 
 void CausticSplats::reset(int indices, int width, int height) {
   const size_t size = size_t(indices) * size_t(width) * size_t(height) * 3;
-  if (size != size_) {
+  if (size > capacity_) {  // a pass's last, shorter batch reuses the cells
     cells_ = std::make_unique<std::atomic<int64_t>[]>(size);
-    size_ = size;
+    capacity_ = size;
   }
+  size_ = size;
   indices_ = indices;
   width_ = width;
   height_ = height;
@@ -140,9 +141,7 @@ void CausticTracer::traceAlone(const Scene& scene, int maxDepth, int rrDepth, ui
                                uint64_t firstIndex, int count, CausticSplats& splats,
                                PathStats& stats) const {
   if (!enabled_ || count <= 0) return;
-  const uint64_t pixels = uint64_t(scene.camera().width()) * uint64_t(scene.camera().height());
-  const uint64_t paths = pathCount(pixels);
-  const float pathsPerPixel = float(double(paths) / double(pixels));
+  const auto [paths, pathsPerPixel] = batchFor(scene.camera());
   std::mutex statsMutex;
   tbb::parallel_for(
       tbb::blocked_range<uint64_t>(0, paths * uint64_t(count), kPathsPerTask),

@@ -27,6 +27,7 @@
 
 #include "core/alias_table.h"
 #include "core/math.h"
+#include "renderer/camera.h"
 #include "renderer/sampler.h"
 
 #include <algorithm>
@@ -62,7 +63,7 @@ class CausticSplats {
  private:
   static constexpr double kScale = 16777216.0;  // 2^24
   int indices_ = 0, width_ = 0, height_ = 0;
-  size_t size_ = 0;
+  size_t size_ = 0, capacity_ = 0;
   std::unique_ptr<std::atomic<int64_t>[]> cells_;
 };
 
@@ -81,9 +82,17 @@ class CausticTracer {
   const char* whyDisabled() const { return whyDisabled_; }
   const std::vector<CausticCaster>& casters() const { return casters_; }
 
-  // Light paths per sample index for an image of `pixels` pixels (at least one).
-  uint64_t pathCount(uint64_t pixels) const {
-    return std::max<uint64_t>(1, uint64_t(std::ceil(double(pixels) * double(pathsPerPixel_))));
+  // Light paths per sample index for the camera's image (at least one), and the paths per pixel
+  // that are, which each splat is divided by.
+  struct Batch {
+    uint64_t paths;
+    float pathsPerPixel;
+  };
+  Batch batchFor(const Camera& camera) const {
+    const uint64_t pixels = uint64_t(camera.width()) * uint64_t(camera.height());
+    const uint64_t paths =
+        std::max<uint64_t>(1, uint64_t(std::ceil(double(pixels) * double(pathsPerPixel_))));
+    return {paths, float(double(paths) / double(pixels))};
   }
 
   // One light path as a state machine, for the scalar driver (traceAlone) and for drivers that
