@@ -44,7 +44,10 @@ void traceCausticsInWaves(const Scene& scene, int maxDepth, int rrDepth, uint64_
                           BatchTraversal traversal) {
   const CausticTracer& tracer = scene.causticTracer();
   if (!tracer.enabled() || count <= 0) return;
-  const auto [paths, pathsPerPixel] = tracer.batchFor(scene.camera());
+  // Plain variables, not a structured binding: Clang 14 cannot capture those in the lambda.
+  const CausticTracer::Batch batch = tracer.batchFor(scene.camera());
+  const uint64_t paths = batch.paths;
+  const float pathsPerPixel = batch.pathsPerPixel;
   std::mutex statsMutex;
   tbb::parallel_for(
       tbb::blocked_range<uint64_t>(0, paths * uint64_t(count), LightWave::kSize),

@@ -141,7 +141,10 @@ void CausticTracer::traceAlone(const Scene& scene, int maxDepth, int rrDepth, ui
                                uint64_t firstIndex, int count, CausticSplats& splats,
                                PathStats& stats) const {
   if (!enabled_ || count <= 0) return;
-  const auto [paths, pathsPerPixel] = batchFor(scene.camera());
+  // Plain variables, not a structured binding: Clang 14 cannot capture those in the lambda.
+  const CausticTracer::Batch batch = batchFor(scene.camera());
+  const uint64_t paths = batch.paths;
+  const float pathsPerPixel = batch.pathsPerPixel;
   std::mutex statsMutex;
   tbb::parallel_for(
       tbb::blocked_range<uint64_t>(0, paths * uint64_t(count), kPathsPerTask),
