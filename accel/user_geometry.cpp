@@ -1,5 +1,6 @@
 #include "accel/user_geometry.h"
 
+#include "accel/packet_tfar.h"
 #include "accel/shape.h"
 
 #include <algorithm>
@@ -116,9 +117,15 @@ void shapeIntersectCallback(const RTCIntersectFunctionNArguments* args) {
   // Embree visits them in another order for single rays than for packets. So the shapes see tfar
   // one float step further, and every hit that rounds onto tfar reaches the rule below.
   float tfar[RayLanes::kMaxLanes];  // Embree calls with packets of 16 or single rays (PacketLanes)
-  for (unsigned i = 0; i < n; ++i) {
-    tfar[i] = RTCRayN_tfar(rays, n, i);
-    if (args->valid[i]) RTCRayN_tfar(rays, n, i) = nextFloatUp(tfar[i]);
+  float* rayTfar = &RTCRayN_tfar(rays, n, 0);
+  const bool packet16 = n == kPacketTfarLanes;
+  if (packet16) {
+    widenLiveTfar16(rayTfar, args->valid, tfar);
+  } else {
+    for (unsigned i = 0; i < n; ++i) {
+      tfar[i] = rayTfar[i];
+      if (args->valid[i]) rayTfar[i] = nextFloatUp(tfar[i]);
+    }
   }
   intersectPacket(*geometry->shape, geometry->needsUv, rays, n, args->valid,
                   [&](unsigned i, const LocalHit& h) {
@@ -140,8 +147,12 @@ void shapeIntersectCallback(const RTCIntersectFunctionNArguments* args) {
                     RTCHitN_geomID(hits, n, i) = args->geomID;
                     RTCHitN_instID(hits, n, i, 0) = args->context->instID[0];
                   });
-  for (unsigned i = 0; i < n; ++i)
-    if (args->valid[i]) RTCRayN_tfar(rays, n, i) = tfar[i];
+  if (packet16) {
+    storeLiveTfar16(rayTfar, args->valid, tfar);
+  } else {
+    for (unsigned i = 0; i < n; ++i)
+      if (args->valid[i]) rayTfar[i] = tfar[i];
+  }
 }
 
 void shapeOccludedCallback(const RTCOccludedFunctionNArguments* args) {

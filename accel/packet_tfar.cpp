@@ -1,0 +1,58 @@
+// Compiled once per SIMD target by Highway's foreach_target.h; see accel/packet_tfar.h.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "accel/packet_tfar.cpp"
+#include <hwy/foreach_target.h>  // must come before highway.h
+#include <hwy/highway.h>
+
+#include "accel/packet_tfar.h"
+
+#include <limits>
+
+HWY_BEFORE_NAMESPACE();
+namespace ember::HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+using D = hn::CappedTag<float, kPacketTfarLanes>;
+
+void WidenLiveTfar16(float* tfar, const int* valid, float* saved) {
+  const D d;
+  const hn::RebindToSigned<D> di;
+  const auto infinity = hn::Set(d, std::numeric_limits<float>::infinity());
+  for (unsigned i = 0; i < kPacketTfarLanes; i += unsigned(hn::Lanes(d))) {
+    const auto t = hn::LoadU(d, tfar + i);
+    hn::StoreU(t, d, saved + i);
+    const auto live = hn::RebindMask(d, hn::Ne(hn::LoadU(di, valid + i), hn::Zero(di)));
+    // The next float up of a positive float is its bit pattern plus one.
+    const auto up = hn::BitCast(d, hn::Add(hn::BitCast(di, t), hn::Set(di, 1)));
+    hn::StoreU(hn::IfThenElse(hn::And(live, hn::Lt(t, infinity)), up, t), d, tfar + i);
+  }
+}
+
+void StoreLiveTfar16(float* tfar, const int* valid, const float* result) {
+  const D d;
+  const hn::RebindToSigned<D> di;
+  for (unsigned i = 0; i < kPacketTfarLanes; i += unsigned(hn::Lanes(d))) {
+    const auto live = hn::RebindMask(d, hn::Ne(hn::LoadU(di, valid + i), hn::Zero(di)));
+    hn::StoreU(hn::IfThenElse(live, hn::LoadU(d, result + i), hn::LoadU(d, tfar + i)), d, tfar + i);
+  }
+}
+
+}  // namespace ember::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace ember {
+
+HWY_EXPORT(WidenLiveTfar16);
+HWY_EXPORT(StoreLiveTfar16);
+
+void widenLiveTfar16(float* tfar, const int* valid, float* saved) {
+  HWY_DYNAMIC_DISPATCH(WidenLiveTfar16)(tfar, valid, saved);
+}
+
+void storeLiveTfar16(float* tfar, const int* valid, const float* result) {
+  HWY_DYNAMIC_DISPATCH(StoreLiveTfar16)(tfar, valid, result);
+}
+
+}  // namespace ember
+#endif
