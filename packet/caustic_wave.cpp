@@ -1,5 +1,9 @@
 #include "packet/caustic_wave.h"
 
+#include "materials/material.h"
+#include "renderer/sampler_lanes.h"
+#include "renderer/scene.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/partitioner.h>
@@ -7,7 +11,9 @@
 #include <pmmintrin.h>
 #include <xmmintrin.h>
 
+#include <algorithm>
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <mutex>
 
@@ -27,6 +33,22 @@ struct LightWave {
   std::array<uint16_t, kSize> active, next;
   std::array<CausticTracer::Splat, kSize> splats;  // the bounce's camera connections
   std::array<int, kSize> splatImage;
+  // The bounce's scattering vertices (index v, in arrival order), and their BSDF samples in
+  // shading order (index o: grouped by material, so that each material samples its run at once).
+  std::array<SurfaceHit, kSize> hits;
+  std::array<uint16_t, kSize> vertexLane;
+  std::array<uint64_t, kSize> materialKey;  // material address << 16 | v
+  std::array<const SurfaceHit*, kSize> hitOf;
+  std::array<Vec3, kSize> wo;
+  std::array<Vec2, kSize> bsdfU;
+  std::array<float, kSize> bsdfLobe;
+  std::array<BsdfSample, kSize> bsdf;
+  std::array<bool, kSize> bsdfSampled;
+  // Samplers whose next requests are drawn together (renderer/sampler_lanes.h), and the numbers.
+  std::array<Sampler*, kSize> samplerOf;
+  std::array<float, kSize> drawn1D;
+  std::array<Vec2, kSize> drawn2D;
+  std::array<CausticTracer::EmissionNumbers, kSize> emission;
   ClosestHitBatch closest{kSize};
   ShadowBatch shadows{kSize};
 };
@@ -58,12 +80,25 @@ void traceCausticsInWaves(const Scene& scene, int maxDepth, int rrDepth, uint64_
         PathStats local;
         size_t active = 0;
         wave.closest.clear();
-        for (uint64_t k = range.begin(); k != range.end(); ++k) {
-          const size_t i = size_t(k - range.begin());
-          const uint64_t index = k / paths;
+        // The emissions: every path's four requests drawn together, in start's order.
+        const size_t count = size_t(range.size());
+        for (size_t i = 0; i < count; ++i) {
+          const uint64_t k = range.begin() + i;
+          wave.lanes[i].sampler = CausticTracer::samplerFor(type, seed, k % paths, firstIndex + k / paths);
+          wave.samplerOf[i] = &wave.lanes[i].sampler;
+        }
+        draw1DThen2DLanes(wave.samplerOf.data(), count, wave.drawn1D.data(), wave.drawn2D.data());
+        for (size_t i = 0; i < count; ++i) {
+          wave.emission[i].light = wave.drawn1D[i];
+          wave.emission[i].area = wave.drawn2D[i];
+        }
+        draw1DThen2DLanes(wave.samplerOf.data(), count, wave.drawn1D.data(), wave.drawn2D.data());
+        for (size_t i = 0; i < count; ++i) {
+          wave.emission[i].pick = wave.drawn1D[i];
+          wave.emission[i].direction = wave.drawn2D[i];
           LightWave::Lane& lane = wave.lanes[i];
-          lane.sampler = CausticTracer::samplerFor(type, seed, k % paths, firstIndex + index);
-          if (tracer.start(lane.sampler, int(index), pathsPerPixel, maxDepth, lane.path)) {
+          if (tracer.startWith(wave.emission[i], int((range.begin() + i) / paths), pathsPerPixel, maxDepth,
+                               lane.path)) {
             wave.active[active++] = uint16_t(i);
             wave.closest.push(lane.path.ray);
           }
@@ -71,24 +106,57 @@ void traceCausticsInWaves(const Scene& scene, int maxDepth, int rrDepth, uint64_
         while (active > 0) {
           local.rays += active;
           wave.closest.trace(scene.accel(), traversal);
+          // CausticTracer::onHit in its steps, each for the whole bounce: arrival and the camera
+          // connections, then the BSDFs' numbers and samples, then the next rays.
           wave.shadows.clear();
-          size_t next = 0;
+          size_t vertices = 0;
           for (size_t a = 0; a < active; ++a) {
             LightWave::Lane& lane = wave.lanes[wave.active[a]];
             RawHit raw;
             if (!wave.closest.hit(a, raw)) continue;
-            SurfaceHit hit;
+            SurfaceHit& hit = wave.hits[vertices];
             scene.surfaceHit(lane.path.ray, raw, hit);
             CausticTracer::Splat& splat = wave.splats[wave.shadows.size()];
-            bool continues;
-            if (tracer.onHit(scene, maxDepth, rrDepth, lane.path, hit, lane.sampler, splat, continues)) {
+            bool scatters;
+            if (tracer.connect(scene, maxDepth, lane.path, hit, splat, scatters)) {
               wave.splatImage[wave.shadows.size()] = lane.path.index;
               wave.shadows.push(splat.ray);
             }
-            if (continues) wave.next[next++] = wave.active[a];
+            if (!scatters) continue;
+            wave.vertexLane[vertices] = wave.active[a];
+            wave.materialKey[vertices] = uint64_t(reinterpret_cast<uintptr_t>(hit.material)) << 16 | vertices;
+            ++vertices;
+          }
+          // Each lane's sample does not depend on the order the lanes are shaded in.
+          std::sort(wave.materialKey.begin(), wave.materialKey.begin() + ptrdiff_t(vertices));
+          for (size_t o = 0; o < vertices; ++o) {
+            const size_t v = wave.materialKey[o] & 0xffffu;
+            LightWave::Lane& lane = wave.lanes[wave.vertexLane[v]];
+            wave.hitOf[o] = &wave.hits[v];
+            wave.wo[o] = -lane.path.ray.dir;
+            wave.samplerOf[o] = &lane.sampler;
+          }
+          draw2DThen1DLanes(wave.samplerOf.data(), vertices, wave.bsdfU.data(), wave.bsdfLobe.data());
+          for (size_t first = 0; first < vertices;) {
+            const Material* material = wave.hitOf[first]->material;
+            size_t end = first + 1;
+            while (end < vertices && wave.hitOf[end]->material == material) ++end;
+            material->sampleLanes(&wave.hitOf[first], &wave.wo[first], &wave.bsdfU[first],
+                                  &wave.bsdfLobe[first], end - first, &wave.bsdf[first],
+                                  &wave.bsdfSampled[first]);
+            first = end;
           }
           wave.closest.clear();  // its hits are all read
-          for (size_t a = 0; a < next; ++a) wave.closest.push(wave.lanes[wave.next[a]].path.ray);
+          size_t next = 0;
+          for (size_t o = 0; o < vertices; ++o) {
+            const uint16_t l = wave.vertexLane[wave.materialKey[o] & 0xffffu];
+            LightWave::Lane& lane = wave.lanes[l];
+            if (tracer.follow(rrDepth, lane.path, *wave.hitOf[o], wave.wo[o], wave.bsdf[o],
+                              wave.bsdfSampled[o], lane.sampler)) {
+              wave.next[next++] = l;
+              wave.closest.push(lane.path.ray);
+            }
+          }
           local.shadowRays += wave.shadows.size();
           wave.shadows.trace(scene.accel(), traversal);
           for (size_t j = 0; j < wave.shadows.size(); ++j)

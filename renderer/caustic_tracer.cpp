@@ -177,16 +177,25 @@ void CausticTracer::traceAlone(const Scene& scene, int maxDepth, int rrDepth, ui
 
 bool CausticTracer::start(Sampler& sampler, int index, float pathsPerPixel, int maxDepth,
                           PathState& path) const {
+  EmissionNumbers u;
+  u.light = sampler.get1D();
+  u.area = sampler.get2D();
+  u.pick = sampler.get1D();
+  u.direction = sampler.get2D();
+  return startWith(u, index, pathsPerPixel, maxDepth, path);
+}
+
+bool CausticTracer::startWith(const EmissionNumbers& u, int index, float pathsPerPixel, int maxDepth,
+                              PathState& path) const {
   // Segments counted as the path tracer counts them, the camera's included: a connection from
   // the vertex at the end of light segment n makes a path of n + 1, and the shortest caustic
   // (light -> caster -> receiver -> camera) has 3.
   if (maxDepth >= 0 && maxDepth < 3) return false;
   // A light by power, a point uniformly on it, a direction towards a caster.
-  const size_t li = lightChoice_.sample(sampler.get1D());
+  const size_t li = lightChoice_.sample(u.light);
   const AreaLight& light = *lights_[li];
-  const ShapeSample y = light.shape()->sampleArea(sampler.get2D());
-  const float uPick = sampler.get1D();
-  const Vec3 dir = sampleDirection(y.p, uPick, sampler.get2D());
+  const ShapeSample y = light.shape()->sampleArea(u.area);
+  const Vec3 dir = sampleDirection(y.p, u.pick, u.direction);
   const float cosLight = glm::dot(dir, y.n);
   if (!light.twoSided() && !(cosLight > 0.0f)) return false;
   const float pdfDir = directionPdf(y.p, dir);
@@ -204,6 +213,21 @@ bool CausticTracer::start(Sampler& sampler, int index, float pathsPerPixel, int 
 bool CausticTracer::onHit(const Scene& scene, int maxDepth, int rrDepth, PathState& path,
                           const SurfaceHit& hit, Sampler& sampler, Splat& splat, bool& continues) const {
   continues = false;
+  bool scatters;
+  const bool connects = connect(scene, maxDepth, path, hit, splat, scatters);
+  if (!scatters) return connects;
+  const Vec3 wo = -path.ray.dir;
+  const Vec2 u = sampler.get2D();
+  const float uLobe = sampler.get1D();
+  BsdfSample bs;
+  const bool sampled = hit.material->sample(hit, wo, u, uLobe, bs);
+  continues = follow(rrDepth, path, hit, wo, bs, sampled, sampler);
+  return connects;
+}
+
+bool CausticTracer::connect(const Scene& scene, int maxDepth, PathState& path, const SurfaceHit& hit,
+                            Splat& splat, bool& scatters) const {
+  scatters = false;
   if (!hit.material) return false;
   const Material& m = *hit.material;
   if (glm::dot(path.ray.dir, hit.ng) > 0.0f) path.beta *= m.interiorTransmittance(hit.t);
@@ -237,29 +261,29 @@ bool CausticTracer::onHit(const Scene& scene, int maxDepth, int rrDepth, PathSta
     }
   }
   // The next connection would make a path of segments + 2.
-  if (maxDepth >= 0 && path.segments + 2 > maxDepth) return connects;
+  scatters = !(maxDepth >= 0 && path.segments + 2 > maxDepth);
+  return connects;
+}
 
-  BsdfSample bs;
-  const Vec2 u = sampler.get2D();
-  const float uLobe = sampler.get1D();
-  if (!m.sample(hit, wo, u, uLobe, bs)) return connects;
-  if (first && !bs.delta) return connects;  // a non-Dirac lobe next to the light: the path tracer's
+bool CausticTracer::follow(int rrDepth, PathState& path, const SurfaceHit& hit, const Vec3& wo,
+                           const BsdfSample& bs, bool sampled, Sampler& sampler) const {
+  if (!sampled) return false;
+  if (path.segments == 1 && !bs.delta) return false;  // a non-Dirac lobe next to the light: the path tracer's
   // Importance is not scaled by refraction as radiance is (Veach 1997, sec. 5.2): undo the
   // material's 1 / eta^2.
   const Color w = bs.weight * (bs.eta * bs.eta * shadingCorrection(hit, wo, bs.wi));
   path.beta *= w;
   path.scattering *= w;
-  if (isBlack(path.beta)) return connects;
+  if (isBlack(path.beta)) return false;
   if (path.segments >= rrDepth) {
     const float q = std::min(maxComponent(path.scattering), 0.95f);
-    if (sampler.get1D() >= q) return connects;
+    if (sampler.get1D() >= q) return false;
     path.beta /= q;
     path.scattering /= q;
   }
   path.ray = Ray{hit.offsetOrigin(bs.wi), bs.wi};
   ++path.segments;
-  continues = true;
-  return connects;
+  return true;
 }
 
 }  // namespace ember

@@ -40,6 +40,7 @@ namespace ember {
 
 class AreaLight;
 class Scene;
+struct BsdfSample;
 struct PathStats;
 struct SurfaceHit;
 
@@ -114,10 +115,28 @@ class CausticTracer {
   };
   // The path's emission: false if it carries nothing (its direction leaves the emitting side).
   bool start(Sampler& sampler, int index, float pathsPerPixel, int maxDepth, PathState& path) const;
+  // start in its steps, for drivers that draw many samplers' numbers together: the numbers, in
+  // the order start requests them (1D, 2D, 1D, 2D), then the emission they choose.
+  struct EmissionNumbers {
+    float light;     // which light
+    Vec2 area;       // where on it
+    float pick;      // which caster's cone
+    Vec2 direction;  // where in the cone
+  };
+  bool startWith(const EmissionNumbers& u, int index, float pathsPerPixel, int maxDepth,
+                 PathState& path) const;
   // The path's ray found `hit`: asks for a camera connection (returns true and fills `splat`)
   // and samples the next ray into path.ray; `continues` says whether the path goes on.
   bool onHit(const Scene& scene, int maxDepth, int rrDepth, PathState& path, const SurfaceHit& hit,
              Sampler& sampler, Splat& splat, bool& continues) const;
+  // onHit in its steps, for drivers that sample the BSDFs of many vertices together
+  // (Material::sampleLanes): connect (arrival and the camera connection; `scatters` says whether
+  // the vertex samples a BSDF), then the BSDF's numbers (2D, then 1D) and sample for
+  // wo = -path.ray.dir as it was on arrival, then follow (false if the path ends).
+  bool connect(const Scene& scene, int maxDepth, PathState& path, const SurfaceHit& hit, Splat& splat,
+               bool& scatters) const;
+  bool follow(int rrDepth, PathState& path, const SurfaceHit& hit, const Vec3& wo, const BsdfSample& bs,
+              bool sampled, Sampler& sampler) const;
 
   // The light paths of sample indices firstIndex + [0, count) (batch i into splats' image i),
   // each ray cast alone, counting at most maxDepth segments with the camera's (-1: unbounded).
