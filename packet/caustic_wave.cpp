@@ -1,6 +1,7 @@
 #include "packet/caustic_wave.h"
 
 #include "materials/material.h"
+#include "packet/geometry_groups.h"
 #include "renderer/sampler_lanes.h"
 #include "renderer/scene.h"
 
@@ -33,11 +34,11 @@ struct LightWave {
   std::array<uint16_t, kSize> active, next;
   std::array<CausticTracer::Splat, kSize> splats;  // the bounce's camera connections
   std::array<int, kSize> splatImage;
-  // The bounce's scattering vertices (index v, in arrival order), and their BSDF samples in
-  // shading order (index o: grouped by material, so that each material samples its run at once).
+  // The bounce's scattering vertices, grouped by geometry and hence by material, so that each
+  // material samples its run at once.
+  GeometryGroups groups;
   std::array<SurfaceHit, kSize> hits;
   std::array<uint16_t, kSize> vertexLane;
-  std::array<uint64_t, kSize> materialKey;  // material address << 16 | v
   std::array<const SurfaceHit*, kSize> hitOf;
   std::array<Vec3, kSize> wo;
   std::array<Vec2, kSize> bsdfU;
@@ -109,8 +110,10 @@ void traceCausticsInWaves(const Scene& scene, int maxDepth, int rrDepth, uint64_
           // CausticTracer::onHit in its steps, each for the whole bounce: arrival and the camera
           // connections, then the BSDFs' numbers and samples, then the next rays.
           wave.shadows.clear();
+          wave.groups.group(wave.closest, active, scene.geometryCount());
           size_t vertices = 0;
-          for (size_t a = 0; a < active; ++a) {
+          for (size_t o = 0; o < active; ++o) {
+            const size_t a = wave.groups.order()[o];
             LightWave::Lane& lane = wave.lanes[wave.active[a]];
             RawHit raw;
             if (!wave.closest.hit(a, raw)) continue;
@@ -124,23 +127,16 @@ void traceCausticsInWaves(const Scene& scene, int maxDepth, int rrDepth, uint64_
             }
             if (!scatters) continue;
             wave.vertexLane[vertices] = wave.active[a];
-            wave.materialKey[vertices] = uint64_t(reinterpret_cast<uintptr_t>(hit.material)) << 16 | vertices;
+            wave.hitOf[vertices] = &hit;
+            wave.wo[vertices] = -lane.path.ray.dir;
+            wave.samplerOf[vertices] = &lane.sampler;
             ++vertices;
-          }
-          // Each lane's sample does not depend on the order the lanes are shaded in.
-          std::sort(wave.materialKey.begin(), wave.materialKey.begin() + ptrdiff_t(vertices));
-          for (size_t o = 0; o < vertices; ++o) {
-            const size_t v = wave.materialKey[o] & 0xffffu;
-            LightWave::Lane& lane = wave.lanes[wave.vertexLane[v]];
-            wave.hitOf[o] = &wave.hits[v];
-            wave.wo[o] = -lane.path.ray.dir;
-            wave.samplerOf[o] = &lane.sampler;
           }
           draw2DThen1DLanes(wave.samplerOf.data(), vertices, wave.bsdfU.data(), wave.bsdfLobe.data());
           for (size_t first = 0; first < vertices;) {
-            const Material* material = wave.hitOf[first]->material;
+            const Material* material = wave.hits[first].material;
             size_t end = first + 1;
-            while (end < vertices && wave.hitOf[end]->material == material) ++end;
+            while (end < vertices && wave.hits[end].material == material) ++end;
             material->sampleLanes(&wave.hitOf[first], &wave.wo[first], &wave.bsdfU[first],
                                   &wave.bsdfLobe[first], end - first, &wave.bsdf[first],
                                   &wave.bsdfSampled[first]);
@@ -148,12 +144,11 @@ void traceCausticsInWaves(const Scene& scene, int maxDepth, int rrDepth, uint64_
           }
           wave.closest.clear();  // its hits are all read
           size_t next = 0;
-          for (size_t o = 0; o < vertices; ++o) {
-            const uint16_t l = wave.vertexLane[wave.materialKey[o] & 0xffffu];
-            LightWave::Lane& lane = wave.lanes[l];
-            if (tracer.follow(rrDepth, lane.path, *wave.hitOf[o], wave.wo[o], wave.bsdf[o],
-                              wave.bsdfSampled[o], lane.sampler)) {
-              wave.next[next++] = l;
+          for (size_t v = 0; v < vertices; ++v) {
+            LightWave::Lane& lane = wave.lanes[wave.vertexLane[v]];
+            if (tracer.follow(rrDepth, lane.path, wave.hits[v], wave.wo[v], wave.bsdf[v], wave.bsdfSampled[v],
+                              lane.sampler)) {
+              wave.next[next++] = wave.vertexLane[v];
               wave.closest.push(lane.path.ray);
             }
           }

@@ -25,10 +25,7 @@ struct Wave {
   std::array<Lane, kSize> lanes;
   std::array<uint16_t, kSize> active, next, shadowOwner;
   std::array<Color, kSize> shadowContribution;
-  std::array<uint16_t, kSize> order;     // batch indices of the bounce, grouped by geometry
-  std::array<uint32_t, kSize> groupKey;  // geomID + 1 of each batch index's hit, 0 for a miss
-  std::vector<uint16_t> groupStart;      // counting-sort buckets, sized once per scene
-  std::array<uint64_t, kSize> sortKey;   // (geomID + 1) << 16 | batch index, for many geometries
+  GeometryGroups groups;  // the bounce's batch indices, grouped by geometry
   // The bounce's scattering vertices (index s), in shading order.
   std::array<uint16_t, kSize> vertexLane;
   std::array<SurfaceHit, kSize> hits;
@@ -62,29 +59,6 @@ Wave& threadWave() {
   thread_local std::unique_ptr<Wave> wave;
   if (!wave) wave = std::make_unique<Wave>();
   return *wave;
-}
-
-// Orders the bounce's hits by the geometry they hit (misses first), so that consecutive lanes
-// run the same shape, material and light code: the virtual calls of shading then predict well.
-// Each lane's result does not depend on the order lanes are shaded in.
-void groupByGeometry(Wave& wave, size_t active, size_t geometries) {
-  const size_t buckets = geometries + 1;
-  if (buckets > WavefrontIntegrator::kMaxCountingSortBuckets) {
-    for (size_t a = 0; a < active; ++a)
-      wave.sortKey[a] = uint64_t(wave.closest.geometryOf(a) + 1u) << 16 | a;  // misses (0) first
-    std::sort(wave.sortKey.begin(), wave.sortKey.begin() + ptrdiff_t(active));
-    for (size_t o = 0; o < active; ++o) wave.order[o] = uint16_t(wave.sortKey[o] & 0xffffu);
-    return;
-  }
-  if (wave.groupStart.size() < buckets + 1) wave.groupStart.assign(buckets + 1, 0);
-  std::fill(wave.groupStart.begin(), wave.groupStart.begin() + ptrdiff_t(buckets + 1), uint16_t(0));
-  for (size_t a = 0; a < active; ++a) {
-    const uint32_t key = wave.closest.geometryOf(a) + 1u;  // RTC_INVALID_GEOMETRY_ID + 1 == 0
-    wave.groupKey[a] = key;
-    ++wave.groupStart[key + 1];
-  }
-  for (size_t b = 1; b <= buckets; ++b) wave.groupStart[b] += wave.groupStart[b - 1];
-  for (size_t a = 0; a < active; ++a) wave.order[wave.groupStart[wave.groupKey[a]]++] = uint16_t(a);
 }
 
 // Samples every query's light, one Light::sampleLanes call per run of queries of the same light.
@@ -173,10 +147,10 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
 
       // The steps of PathIntegrator::onHit, each for the whole bounce: arrival and the light
       // choice, then the lights' samples, then shadow rays and scattering.
-      groupByGeometry(wave, active, scene.geometryCount());
+      wave.groups.group(wave.closest, active, scene.geometryCount());
       size_t vertices = 0, lightDraws = 0, queries = 0;
       for (size_t o = 0; o < active; ++o) {
-        const size_t a = wave.order[o];
+        const size_t a = wave.groups.order()[o];
         Wave::Lane& lane = wave.lanes[wave.active[a]];
         RawHit raw;
         if (!wave.closest.hit(a, raw)) {

@@ -9,6 +9,7 @@
 // any thread count.
 #pragma once
 
+#include "packet/geometry_groups.h"
 #include "packet/ray_batch.h"
 #include "renderer/path_integrator.h"
 
@@ -24,8 +25,9 @@ class WavefrontIntegrator final : public Integrator {
   static constexpr size_t kWaveSize = 1024;
   static_assert(kWaveSize <= (1u << 15), "wave indices are uint16_t / int16_t");
   // Above this many geometries the bounce's hits are grouped by sorting their keys rather than
-  // by a counting sort, whose buckets would then cost more to clear than the keys to sort.
-  static constexpr size_t kMaxCountingSortBuckets = 1024;
+  // by a counting sort (packet/geometry_groups.h).
+  static constexpr size_t kMaxCountingSortBuckets = GeometryGroups::kMaxCountingSortBuckets;
+  static_assert(kWaveSize <= GeometryGroups::kMaxLanes);
 
   explicit WavefrontIntegrator(const RenderSettings& s, BatchTraversal traversal = BatchTraversal::Packets)
       : path_(s), traversal_(traversal) {}

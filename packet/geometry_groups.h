@@ -1,0 +1,34 @@
+// A bounce's hits ordered by the geometry they hit (misses first), so that consecutive lanes run
+// the same shape, material and light code: the virtual calls of shading then predict well, and
+// each material's run of vertices samples its BSDF at once (Material::sampleLanes). Each lane's
+// result does not depend on the order lanes are shaded in, so any order gives the same image.
+#pragma once
+
+#include "packet/ray_batch.h"
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace ember {
+
+class GeometryGroups {
+ public:
+  static constexpr size_t kMaxLanes = 1024;
+  // Above this many geometries the buckets of a counting sort would cost more to clear than the
+  // keys to sort.
+  static constexpr size_t kMaxCountingSortBuckets = 1024;
+
+  // order()[0, active) lists the batch indices [0, active) of `batch`, grouped by geomID.
+  void group(const ClosestHitBatch& batch, size_t active, size_t geometries);
+  const uint16_t* order() const { return order_.data(); }
+
+ private:
+  std::array<uint16_t, kMaxLanes> order_;
+  std::array<uint32_t, kMaxLanes> key_;      // geomID + 1 of each batch index's hit, 0 for a miss
+  std::array<uint64_t, kMaxLanes> sortKey_;  // (geomID + 1) << 16 | batch index, for many geometries
+  std::vector<uint16_t> start_;              // counting-sort buckets, sized once per scene
+};
+
+}  // namespace ember
