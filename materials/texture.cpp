@@ -34,6 +34,34 @@ class ChannelPalette {
   int size_ = 0;
 };
 
+// The distinct colours of an image, by bit pattern, in an open-addressing table of twice the
+// palette's size: index(c) gives the colour's palette slot, or -1 once a 257th colour appears.
+class ColorPalette {
+ public:
+  int index(const Color& c, std::vector<Color>& palette) {
+    std::array<uint32_t, 3> bits;
+    std::memcpy(bits.data(), &c[0], sizeof bits);
+    const uint32_t hash = (bits[0] * 0x9e3779b1u) ^ (bits[1] * 0x85ebca6bu) ^ (bits[2] * 0xc2b2ae35u);
+    for (uint32_t slot = hash >> (32 - kLog2Slots);; slot = (slot + 1) & (kSlots - 1)) {
+      if (used_[slot] && keys_[slot] == bits) return index_[slot];
+      if (used_[slot]) continue;
+      if (palette.size() == 256) return -1;
+      used_[slot] = true;
+      keys_[slot] = bits;
+      index_[slot] = uint8_t(palette.size());
+      palette.push_back(c);
+      return int(palette.size()) - 1;
+    }
+  }
+
+ private:
+  static constexpr int kLog2Slots = 9;
+  static constexpr uint32_t kSlots = 1u << kLog2Slots;
+  std::array<std::array<uint32_t, 3>, kSlots> keys_{};
+  std::array<uint8_t, kSlots> index_{};
+  std::array<bool, kSlots> used_{};
+};
+
 }  // namespace
 
 ImageTexture::ImageTexture(int width, int height, std::vector<Color> texels, TextureFilter filter,
@@ -53,7 +81,25 @@ ImageTexture::ImageTexture(int width, int height, std::vector<Color> texels, Tex
   if (!texels_.empty()) average_ = sum / float(texels_.size());
 
   // First the palettes, which an HDR image overflows within its first few hundred texels; the
-  // indices only once they fit.
+  // indices only once they fit. A colour palette first: one byte per texel.
+  {
+    ColorPalette colors;
+    std::vector<Color> palette;
+    bool fits = true;
+    for (const Color& t : texels_)
+      if (colors.index(t, palette) < 0) {
+        fits = false;
+        break;
+      }
+    if (fits) {
+      indices_.resize(texels_.size());
+      for (size_t i = 0; i < texels_.size(); ++i) indices_[i] = uint8_t(colors.index(texels_[i], palette));
+      colorPalette_ = std::move(palette);
+      paletted_ = true;
+      std::vector<Color>().swap(texels_);
+      return;
+    }
+  }
   ChannelPalette channels[3];
   for (const Color& t : texels_)
     for (int c = 0; c < 3; ++c)
@@ -86,6 +132,7 @@ Color ImageTexture::texel(int x, int y) const {
   y = wrapIndex(y, height_, wrapT_);
   const size_t i = size_t(y) * size_t(width_) + size_t(x);
   if (!paletted_) return texels_[i];
+  if (!colorPalette_.empty()) return colorPalette_[indices_[i]];
   const uint8_t* k = &indices_[3 * i];
   return {palette_[0][k[0]], palette_[1][k[1]], palette_[2][k[2]]};
 }

@@ -55,6 +55,8 @@ class ImageTexture final : public Texture {
   int height() const { return height_; }
   // Whether the texels are kept as palette indices (see below).
   bool paletted() const { return paletted_; }
+  // Memory per texel: 1 byte (a colour palette), 3 (per-channel palettes) or 12 (floats).
+  int bytesPerTexel() const { return !paletted_ ? 12 : colorPalette_.empty() ? 3 : 1; }
 
  private:
   Color texel(int x, int y) const;
@@ -63,10 +65,13 @@ class ImageTexture final : public Texture {
   // Texels of at most 256 distinct values per channel (every 8-bit image, whatever its encoding)
   // are kept as one byte per channel into a per-channel palette of their exact floats: a quarter of
   // the memory and of the cache misses of incoherent lookups, and the same values bit for bit.
-  // Other images (HDR, 16-bit) keep their floats in texels_.
+  // Images of at most 256 distinct colours (indexed images, masks, checkerboards) keep one byte
+  // per texel into a palette of whole colours, a third of that again. Other images (HDR, 16-bit)
+  // keep their floats in texels_.
   std::vector<Color> texels_;
-  std::vector<uint8_t> indices_;  // 3 per texel, when paletted
+  std::vector<uint8_t> indices_;  // 3 per texel (per-channel palettes) or 1 (a colour palette)
   std::array<std::array<float, 256>, 3> palette_{};
+  std::vector<Color> colorPalette_;  // the colour palette's colours, when it is used
   bool paletted_ = false;
   TextureFilter filter_;
   TextureWrap wrapS_, wrapT_;

@@ -10,6 +10,7 @@
 #include "accel/box.h"
 #include "accel/cylinder.h"
 #include "accel/flipped_shape.h"
+#include "accel/packet_tfar.h"
 #include "accel/sphere.h"
 #include "accel/triangle.h"
 #include "core/ray_spawn.h"
@@ -19,8 +20,11 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <bit>
+#include <cstdint>
 #include <cstring>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -480,6 +484,44 @@ TEST(ShapeLanes, SphereLaneWithAZeroDirectionGetsTheScalarResult) {
   }
   EXPECT_FALSE((hits.mask >> 5) & 1u);
   EXPECT_EQ(__builtin_popcount(hits.mask), 14);
+}
+
+}  // namespace
+}  // namespace ember
+
+namespace ember {
+namespace {
+
+// accel/packet_tfar.h against the scalar loops it replaced in the intersect callback: every lane,
+// live or not, with finite, infinite, zero and negative tfar.
+TEST(PacketTfar, VectorPassesEqualTheScalarLoops) {
+  Rng rng(7, 1);
+  const float special[] = {kInfinity, 0.0f, -1.0f, 1e-30f, std::numeric_limits<float>::max(), 3.5f};
+  for (int trial = 0; trial < 200; ++trial) {
+    alignas(64) float tfar[kPacketTfarLanes], expected[kPacketTfarLanes];
+    alignas(64) int valid[kPacketTfarLanes];
+    for (unsigned i = 0; i < kPacketTfarLanes; ++i) {
+      tfar[i] = rng.uniform() < 0.3f ? special[rng.nextU32() % 6] : 100.0f * rng.uniform();
+      valid[i] = rng.uniform() < 0.5f ? -1 : 0;
+    }
+    float saved[kPacketTfarLanes], savedExpected[kPacketTfarLanes];
+    std::memcpy(expected, tfar, sizeof(tfar));
+    for (unsigned i = 0; i < kPacketTfarLanes; ++i) {
+      savedExpected[i] = expected[i];
+      if (valid[i] && expected[i] < kInfinity)
+        expected[i] = std::bit_cast<float>(std::bit_cast<uint32_t>(expected[i]) + 1u);
+    }
+    widenLiveTfar16(tfar, valid, saved);
+    ASSERT_EQ(0, std::memcmp(saved, savedExpected, sizeof(saved))) << "trial " << trial;
+    ASSERT_EQ(0, std::memcmp(tfar, expected, sizeof(tfar))) << "trial " << trial;
+
+    float result[kPacketTfarLanes];
+    for (unsigned i = 0; i < kPacketTfarLanes; ++i) result[i] = 1000.0f + float(i);
+    for (unsigned i = 0; i < kPacketTfarLanes; ++i)
+      if (valid[i]) expected[i] = result[i];
+    storeLiveTfar16(tfar, valid, result);
+    ASSERT_EQ(0, std::memcmp(tfar, expected, sizeof(tfar))) << "trial " << trial;
+  }
 }
 
 }  // namespace

@@ -47,6 +47,25 @@ TEST(ImageTexture, EightBitImagesReadBackExactly) {
   expectExactTexels(texels, w, h, true);
 }
 
+TEST(ImageTexture, ImagesOfFewColoursKeepOneBytePerTexel) {
+  // 256 distinct colours (a checkerboard's two and 254 more; -0 and +0 differ), each channel's
+  // values shared between colours: one byte per texel, read back exactly.
+  const int w = 64, h = 16;
+  std::vector<Color> texels(size_t(w * h));
+  for (size_t i = 0; i < texels.size(); ++i) {
+    const size_t k = i % 256;
+    texels[i] = Color(float(k % 7) / 6.0f, float(k / 7) / 36.0f, (k % 2) ? 0.0f : -0.0f);
+  }
+  expectExactTexels(texels, w, h, true);
+  EXPECT_EQ(ImageTexture(w, h, texels, TextureFilter::Nearest, TextureWrap::Clamp).bytesPerTexel(), 1);
+  // A 257th colour whose channels are all values seen before: per-channel palettes, still exact.
+  texels[300] =
+      Color(texels[1].r, texels[7].g, texels[1].b);  // (1/6, 1/36, +0): only k = 8 has the first two, with -0
+  ASSERT_NE(bitsOf(texels[300].g), bitsOf(texels[1].g));
+  expectExactTexels(texels, w, h, true);
+  EXPECT_EQ(ImageTexture(w, h, texels, TextureFilter::Nearest, TextureWrap::Clamp).bytesPerTexel(), 3);
+}
+
 TEST(ImageTexture, HighDynamicRangeImagesReadBackExactly) {
   // 257 distinct values in one channel: beyond a palette, kept as floats.
   const int w = 257, h = 3;
