@@ -67,6 +67,7 @@ struct BenchArgs {
   int repeat = 3;
   std::string json;
   std::string kernel = "wavefront";
+  std::string caustics;  // "trace", "path", or empty: each scene's render.caustic_tracing
 };
 
 int runBench(const BenchArgs& a) {
@@ -93,6 +94,7 @@ int runBench(const BenchArgs& a) {
     Scene scene = loadScene(path);
     const double loadSeconds = secondsSince(loadStart);
     if (a.spp) scene.settings.spp = *a.spp;
+    if (!a.caustics.empty()) scene.settings.traceCaustics = a.caustics == "trace";
     const auto buildStart = Clock::now();
     scene.build();
     const double buildSeconds = secondsSince(buildStart);
@@ -122,6 +124,7 @@ int runBench(const BenchArgs& a) {
         {"width", scene.settings.width},
         {"height", scene.settings.height},
         {"spp", options.spp},
+        {"caustics", integrator->tracesCaustics() && scene.causticTracer().enabled() ? "trace" : "path"},
         {"threads", med.threads},
         {"load_seconds", loadSeconds},
         {"build_seconds", buildSeconds},
@@ -179,6 +182,10 @@ Runner addBenchCommand(CLI::App& app) {
   cmd->add_option("--kernel", args->kernel,
                   "wavefront (default), stream or scalar; see `ember render --help`")
       ->check(CLI::IsMember({"wavefront", "stream", "scalar"}));
+  cmd->add_option(
+         "--caustics", args->caustics,
+         "trace or path, as `ember render --caustics` (default: each scene's render.caustic_tracing)")
+      ->check(CLI::IsMember({"trace", "path"}));
   cmd->add_option("--json", args->json, "Also write the results as JSON (layout: docs/performance.md)");
   return [args] { return runBench(*args); };
 }
