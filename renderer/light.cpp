@@ -115,22 +115,18 @@ TriangleLight::TriangleLight(const TriangleMesh* mesh, uint32_t prim, const Colo
                              const Texture* texture, bool twoSided)
     : mesh_(mesh),
       prim_(prim),
+      v_{mesh->positions[mesh->indices[prim].x], mesh->positions[mesh->indices[prim].y],
+         mesh->positions[mesh->indices[prim].z]},
+      ng_(mesh->surfaceAt(prim, 0.0f, 0.0f).ng),
       radiance_(radiance),
       texture_(texture),
       twoSided_(twoSided),
       pError_(mesh->pointError(prim)),
       area_(mesh->triangleArea(prim)) {}
 
-// The spherical triangle of `prim` seen from ref, when light sampling should use it.
-static std::optional<SphericalTriangle> sphericalTriangle(const TriangleMesh& mesh, uint32_t prim, float area,
-                                                          const Vec3& ref) {
-  const glm::uvec3& idx = mesh.indices[prim];
-  return sphericalTriangleForSampling(ref, mesh.positions[idx.x], mesh.positions[idx.y],
-                                      mesh.positions[idx.z], area);
-}
-
 float TriangleLight::pdf(const Vec3& ref, const Vec3& p, const Vec3& n) const {
-  if (const auto st = sphericalTriangle(*mesh_, prim_, area_, ref)) return float(1.0 / st->solidAngle());
+  if (const auto st = sphericalTriangleForSampling(ref, v_[0], v_[1], v_[2], area_))
+    return float(1.0 / st->solidAngle());
   return areaToSolidAnglePdf(1.0f / area_, ref, p, n);
 }
 
@@ -138,30 +134,31 @@ bool TriangleLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
   // Barycentrics (b1, b2) of vertices 1 and 2: where a direction uniform in the solid angle meets
   // the triangle, or a point uniform by area.
   Vec2 b;
-  const std::optional<SphericalTriangle> st = sphericalTriangle(*mesh_, prim_, area_, ref);
+  const std::optional<SphericalTriangle> st = sphericalTriangleForSampling(ref, v_[0], v_[1], v_[2], area_);
   if (st) {
-    const glm::uvec3& idx = mesh_->indices[prim_];
-    b = barycentricsAlong(mesh_->positions[idx.x], mesh_->positions[idx.y], mesh_->positions[idx.z], ref,
-                          st->sample(u));
+    b = barycentricsAlong(v_[0], v_[1], v_[2], ref, st->sample(u));
   } else {
     const Vec2 a = sampleUniformTriangle(u);  // barycentrics of vertices 0 and 1
     b = Vec2(a.y, 1.0f - a.x - a.y);
   }
-  const TriangleMesh::Surface surface = mesh_->surfaceAt(prim_, b.x, b.y);
-  const Vec3 p = mesh_->pointAt(prim_, b.x, b.y);
+  // TriangleMesh::pointAt's expression, on the copied vertices.
+  const Vec3 p = (1.0f - b.x - b.y) * v_[0] + b.x * v_[1] + b.y * v_[2];
   const Vec3 d = p - ref;
   out.dist = glm::length(d);
   if (out.dist == 0.0f) return false;
   out.wi = d / out.dist;
   out.p = p;
-  out.n = surface.ng;
+  out.n = ng_;
   out.pError = pError_;
-  out.pdf = st ? float(1.0 / st->solidAngle()) : areaToSolidAnglePdf(1.0f / area_, ref, p, surface.ng);
+  out.pdf = st ? float(1.0 / st->solidAngle()) : areaToSolidAnglePdf(1.0f / area_, ref, p, ng_);
   out.delta = false;
-  out.Li = twoSided_ || glm::dot(-out.wi, surface.ng) > 0.0f ? radiance_ : Color(0.0f);
-  if (texture_) out.Li *= texture_->eval(surface.uv);
-  // Cut-out (MASK) or partly transparent (BLEND) parts emit as much as rays that hit them find.
-  if (mesh_->opacity) out.Li *= mesh_->opacity->coverage(surface.uv);
+  out.Li = twoSided_ || glm::dot(-out.wi, ng_) > 0.0f ? radiance_ : Color(0.0f);
+  if (texture_ || mesh_->opacity) {
+    const Vec2 uv = mesh_->uvAt(prim_, b.x, b.y);
+    if (texture_) out.Li *= texture_->eval(uv);
+    // Cut-out (MASK) or partly transparent (BLEND) parts emit as much as rays that hit them find.
+    if (mesh_->opacity) out.Li *= mesh_->opacity->coverage(uv);
+  }
   return out.pdf > 0.0f && std::isfinite(out.pdf);
 }
 
