@@ -2,7 +2,10 @@
 // produce the scalar reference's image bit for bit, for every shape, material, emitter and light
 // type, every strategy and sampler, any thread count and tile size, and images whose size is not
 // a multiple of the tile or the wave.
+#include "core/rng.h"
+#include "core/sampling.h"
 #include "io/scene_loader.h"
+#include "packet/geometry_groups.h"
 #include "packet/wavefront_integrator.h"
 #include "renderer/render.h"
 
@@ -10,10 +13,12 @@
 
 #include "test_paths.h"
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 namespace ember {
 namespace {
@@ -198,6 +203,31 @@ TEST(Wavefront, CountsTheSameRaysAsScalar) {
   EXPECT_EQ(scalar.rays, wave.rays);
   EXPECT_EQ(scalar.shadowRays, wave.shadowRays);
   EXPECT_EQ(scalar.vertices, wave.vertices);
+}
+
+// packet/geometry_groups.h: a permutation of the batch, grouped by geometry with misses first,
+// and stable within a group; the counting sort and the key sort (many geometries) agree.
+TEST(GeometryGroups, GroupsABatchByGeometryMissesFirst) {
+  const Scene scene = loadBuilt(test::sourcePath("scenes/cornell-point.json"));
+  ClosestHitBatch batch(GeometryGroups::kMaxLanes);
+  Rng rng(5, 9);
+  const size_t n = 1000;
+  for (size_t i = 0; i < n; ++i)  // from in front of the open box: some rays leave the scene
+    batch.push(Ray{Vec3(0.0f, 1.0f, 3.0f), sampleUniformSphere(Vec2(rng.uniform(), rng.uniform()))});
+  batch.trace(scene.accel(), BatchTraversal::Packets);
+  const auto key = [&](size_t a) { return uint32_t(batch.geometryOf(a) + 1u); };  // a miss (~0u) is 0
+  std::vector<size_t> expected(n);
+  for (size_t a = 0; a < n; ++a) expected[a] = a;
+  std::stable_sort(expected.begin(), expected.end(), [&](size_t x, size_t y) { return key(x) < key(y); });
+  ASSERT_EQ(key(expected.front()), 0u) << "no ray missed: the test needs misses";
+  ASSERT_GT(key(expected.back()), 1u);
+  GeometryGroups counting, sorting;
+  counting.group(batch, n, scene.geometryCount());
+  sorting.group(batch, n, GeometryGroups::kMaxCountingSortBuckets + 1);
+  for (size_t o = 0; o < n; ++o) {
+    ASSERT_EQ(counting.order()[o], expected[o]) << "position " << o;
+    ASSERT_EQ(sorting.order()[o], expected[o]) << "position " << o;
+  }
 }
 
 TEST(Wavefront, KernelNames) {
