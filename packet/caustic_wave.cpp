@@ -1,6 +1,7 @@
 #include "packet/caustic_wave.h"
 
 #include "materials/material.h"
+#include "packet/bsdf_batch.h"
 #include "packet/geometry_groups.h"
 #include "renderer/sampler_lanes.h"
 #include "renderer/scene.h"
@@ -39,12 +40,8 @@ struct LightWave {
   GeometryGroups groups;
   std::array<SurfaceHit, kSize> hits;
   std::array<uint16_t, kSize> vertexLane;
-  std::array<const SurfaceHit*, kSize> hitOf;
-  std::array<Vec3, kSize> wo;
-  std::array<Vec2, kSize> bsdfU;
-  std::array<float, kSize> bsdfLobe;
-  std::array<BsdfSample, kSize> bsdf;
-  std::array<bool, kSize> bsdfSampled;
+  BsdfBatch bsdfs;
+  static_assert(kSize <= BsdfBatch::kMaxVertices);
   // Samplers whose next requests are drawn together (renderer/sampler_lanes.h), and the numbers.
   std::array<Sampler*, kSize> samplerOf;
   std::array<float, kSize> drawn1D;
@@ -127,27 +124,19 @@ void traceCausticsInWaves(const Scene& scene, int maxDepth, int rrDepth, uint64_
             }
             if (!scatters) continue;
             wave.vertexLane[vertices] = wave.active[a];
-            wave.hitOf[vertices] = &hit;
-            wave.wo[vertices] = -lane.path.ray.dir;
+            wave.bsdfs.hit[vertices] = &hit;
+            wave.bsdfs.wo[vertices] = -lane.path.ray.dir;
             wave.samplerOf[vertices] = &lane.sampler;
             ++vertices;
           }
-          draw2DThen1DLanes(wave.samplerOf.data(), vertices, wave.bsdfU.data(), wave.bsdfLobe.data());
-          for (size_t first = 0; first < vertices;) {
-            const Material* material = wave.hits[first].material;
-            size_t end = first + 1;
-            while (end < vertices && wave.hits[end].material == material) ++end;
-            material->sampleLanes(&wave.hitOf[first], &wave.wo[first], &wave.bsdfU[first],
-                                  &wave.bsdfLobe[first], end - first, &wave.bsdf[first],
-                                  &wave.bsdfSampled[first]);
-            first = end;
-          }
+          draw2DThen1DLanes(wave.samplerOf.data(), vertices, wave.bsdfs.u.data(), wave.bsdfs.uLobe.data());
+          wave.bsdfs.sampleAll(vertices);
           wave.closest.clear();  // its hits are all read
           size_t next = 0;
           for (size_t v = 0; v < vertices; ++v) {
             LightWave::Lane& lane = wave.lanes[wave.vertexLane[v]];
-            if (tracer.follow(rrDepth, lane.path, wave.hits[v], wave.wo[v], wave.bsdf[v], wave.bsdfSampled[v],
-                              lane.sampler)) {
+            if (tracer.follow(rrDepth, lane.path, wave.hits[v], wave.bsdfs.wo[v], wave.bsdfs.sample[v],
+                              wave.bsdfs.sampled[v], lane.sampler)) {
               wave.next[next++] = wave.vertexLane[v];
               wave.closest.push(lane.path.ray);
             }

@@ -1,6 +1,7 @@
 #include "packet/wavefront_integrator.h"
 
 #include "accel/sampling_lanes.h"
+#include "packet/bsdf_batch.h"
 #include "packet/caustic_wave.h"
 #include "renderer/sampler_lanes.h"
 
@@ -38,13 +39,8 @@ struct Wave {
   std::array<Vec2, kSize> queryU;
   std::array<LightSample, kSize> querySample;
   std::array<bool, kSize> querySampled;
-  // Each vertex's BSDF sample: inputs, then what its material returned.
-  std::array<const SurfaceHit*, kSize> hitOf;
-  std::array<Vec3, kSize> wo;
-  std::array<Vec2, kSize> bsdfU;
-  std::array<float, kSize> bsdfLobe;
-  std::array<BsdfSample, kSize> bsdf;
-  std::array<bool, kSize> bsdfSampled;
+  BsdfBatch bsdfs;  // each vertex's BSDF sample: inputs, then what its material returned
+  static_assert(kSize <= BsdfBatch::kMaxVertices);
   // Samplers whose next request the bounce draws together (renderer/sampler_lanes.h), and the
   // numbers drawn; for the light choice, the vertex each belongs to.
   std::array<Sampler*, kSize> samplerOf;
@@ -82,19 +78,6 @@ void sampleLights(Wave& wave, size_t queries, size_t lights) {
     while (end < queries && (wave.queryKey[end] >> 16) == (wave.queryKey[first] >> 16)) ++end;
     light->sampleLanes(&wave.queryRef[first], &wave.queryU[first], end - first, &wave.querySample[first],
                        &wave.querySampled[first]);
-    first = end;
-  }
-}
-
-// Samples every vertex's BSDF, one Material::sampleLanes call per run of vertices of the same
-// material (the vertices are grouped by geometry, which fixes the material).
-void sampleBsdfs(Wave& wave, size_t vertices) {
-  for (size_t first = 0; first < vertices;) {
-    const Material* material = wave.hits[first].material;
-    size_t end = first + 1;
-    while (end < vertices && wave.hits[end].material == material) ++end;
-    material->sampleLanes(&wave.hitOf[first], &wave.wo[first], &wave.bsdfU[first], &wave.bsdfLobe[first],
-                          end - first, &wave.bsdf[first], &wave.bsdfSampled[first]);
     first = end;
   }
 }
@@ -189,17 +172,17 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
           wave.shadowContribution[wave.shadows.size()] = shadow.contribution;
           wave.shadows.push(shadow.ray);
         }
-        wave.hitOf[v] = &wave.hits[v];
-        wave.wo[v] = -lane.path.ray.dir;
+        wave.bsdfs.hit[v] = &wave.hits[v];
+        wave.bsdfs.wo[v] = -lane.path.ray.dir;
         wave.samplerOf[v] = &lane.sampler;
       }
       // PathIntegrator::drawBsdfSample for the bounce: its 2D, then its 1D request.
-      draw2DThen1DLanes(wave.samplerOf.data(), vertices, wave.bsdfU.data(), wave.bsdfLobe.data());
-      sampleBsdfs(wave, vertices);
+      draw2DThen1DLanes(wave.samplerOf.data(), vertices, wave.bsdfs.u.data(), wave.bsdfs.uLobe.data());
+      wave.bsdfs.sampleAll(vertices);
       wave.closest.clear();  // its hits are all read
       for (size_t v = 0; v < vertices; ++v) {
         Wave::Lane& lane = wave.lanes[wave.vertexLane[v]];
-        if (path_.followBsdfSample(lane.path, wave.hits[v], wave.bsdf[v], wave.bsdfSampled[v],
+        if (path_.followBsdfSample(lane.path, wave.hits[v], wave.bsdfs.sample[v], wave.bsdfs.sampled[v],
                                    lane.sampler)) {
           wave.next[next++] = wave.vertexLane[v];
           wave.closest.push(lane.path.ray);
