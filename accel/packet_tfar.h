@@ -5,9 +5,20 @@
 // a render). Each function does, lane for lane, what the scalar loop it replaces did.
 #pragma once
 
+#include <bit>
+#include <cstdint>
+#include <limits>
+
 namespace ember {
 
 constexpr unsigned kPacketTfarLanes = 16;
+
+// The next float above a ray's tfar (positive, or +infinity, which stays): what the callback
+// shows the shapes. The scalar loop for single rays and the tests use it; the kernels do the same.
+inline float nextFloatUp(float x) {
+  return x < std::numeric_limits<float>::infinity() ? std::bit_cast<float>(std::bit_cast<uint32_t>(x) + 1u)
+                                                    : x;
+}
 
 // saved[i] = tfar[i] for every lane; then each live lane's (valid[i] != 0) tfar moves one float
 // up, except +infinity, which stays.

@@ -102,10 +102,7 @@ void intersectPacket(const Shape& shape, bool needsUv, RTCRayN* rays, unsigned n
   }
 }
 
-// The next float above a ray's tfar (which is positive, or +infinity, which stays).
-inline float nextFloatUp(float x) {
-  return x < kInfinity ? std::bit_cast<float>(std::bit_cast<uint32_t>(x) + 1u) : x;
-}
+static_assert(kPacketTfarLanes <= RayLanes::kMaxLanes);
 
 void shapeIntersectCallback(const RTCIntersectFunctionNArguments* args) {
   const auto* geometry = static_cast<const ShapeGeometry*>(args->geometryUserPtr);

@@ -39,8 +39,9 @@ class ChannelPalette {
 class ColorPalette {
  public:
   int index(const Color& c, std::vector<Color>& palette) {
+    static_assert(sizeof(Color) == sizeof(std::array<uint32_t, 3>));
     std::array<uint32_t, 3> bits;
-    std::memcpy(bits.data(), &c[0], sizeof bits);
+    std::memcpy(bits.data(), &c, sizeof bits);
     const uint32_t hash = (bits[0] * 0x9e3779b1u) ^ (bits[1] * 0x85ebca6bu) ^ (bits[2] * 0xc2b2ae35u);
     for (uint32_t slot = hash >> (32 - kLog2Slots);; slot = (slot + 1) & (kSlots - 1)) {
       if (used_[slot] && keys_[slot] == bits) return index_[slot];

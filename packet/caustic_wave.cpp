@@ -41,7 +41,7 @@ struct LightWave {
   std::array<SurfaceHit, kSize> hits;
   std::array<uint16_t, kSize> vertexLane;
   BsdfBatch bsdfs;
-  static_assert(kSize <= BsdfBatch::kMaxVertices);
+  static_assert(kSize <= BsdfBatch::kMaxVertices && kSize <= GeometryGroups::kMaxLanes);
   // Samplers whose next requests are drawn together (renderer/sampler_lanes.h), and the numbers.
   std::array<Sampler*, kSize> samplerOf;
   std::array<float, kSize> drawn1D;
@@ -63,7 +63,7 @@ void traceCausticsInWaves(const Scene& scene, int maxDepth, int rrDepth, uint64_
                           uint64_t firstIndex, int count, CausticSplats& splats, PathStats& stats,
                           BatchTraversal traversal) {
   const CausticTracer& tracer = scene.causticTracer();
-  if (!tracer.enabled() || count <= 0) return;
+  if (!tracer.enabled() || count <= 0 || !CausticTracer::reachesCaustics(maxDepth)) return;
   // Plain variables, not a structured binding: Clang 14 cannot capture those in the lambda.
   const CausticTracer::Batch batch = tracer.batchFor(scene.camera());
   const uint64_t paths = batch.paths;
@@ -79,19 +79,19 @@ void traceCausticsInWaves(const Scene& scene, int maxDepth, int rrDepth, uint64_
         size_t active = 0;
         wave.closest.clear();
         // The emissions: every path's four requests drawn together, in start's order.
-        const size_t count = size_t(range.size());
-        for (size_t i = 0; i < count; ++i) {
+        const size_t lanes = size_t(range.size());
+        for (size_t i = 0; i < lanes; ++i) {
           const uint64_t k = range.begin() + i;
           wave.lanes[i].sampler = CausticTracer::samplerFor(type, seed, k % paths, firstIndex + k / paths);
           wave.samplerOf[i] = &wave.lanes[i].sampler;
         }
-        draw1DThen2DLanes(wave.samplerOf.data(), count, wave.drawn1D.data(), wave.drawn2D.data());
-        for (size_t i = 0; i < count; ++i) {
+        draw1DThen2DLanes(wave.samplerOf.data(), lanes, wave.drawn1D.data(), wave.drawn2D.data());
+        for (size_t i = 0; i < lanes; ++i) {
           wave.emission[i].light = wave.drawn1D[i];
           wave.emission[i].area = wave.drawn2D[i];
         }
-        draw1DThen2DLanes(wave.samplerOf.data(), count, wave.drawn1D.data(), wave.drawn2D.data());
-        for (size_t i = 0; i < count; ++i) {
+        draw1DThen2DLanes(wave.samplerOf.data(), lanes, wave.drawn1D.data(), wave.drawn2D.data());
+        for (size_t i = 0; i < lanes; ++i) {
           wave.emission[i].pick = wave.drawn1D[i];
           wave.emission[i].direction = wave.drawn2D[i];
           LightWave::Lane& lane = wave.lanes[i];

@@ -140,7 +140,7 @@ Sampler CausticTracer::samplerFor(SamplerType type, uint64_t seed, uint64_t path
 void CausticTracer::traceAlone(const Scene& scene, int maxDepth, int rrDepth, uint64_t seed, SamplerType type,
                                uint64_t firstIndex, int count, CausticSplats& splats,
                                PathStats& stats) const {
-  if (!enabled_ || count <= 0) return;
+  if (!enabled_ || count <= 0 || !reachesCaustics(maxDepth)) return;
   // Plain variables, not a structured binding: Clang 14 cannot capture those in the lambda.
   const CausticTracer::Batch batch = batchFor(scene.camera());
   const uint64_t paths = batch.paths;
@@ -188,9 +188,8 @@ bool CausticTracer::start(Sampler& sampler, int index, float pathsPerPixel, int 
 bool CausticTracer::startWith(const EmissionNumbers& u, int index, float pathsPerPixel, int maxDepth,
                               PathState& path) const {
   // Segments counted as the path tracer counts them, the camera's included: a connection from
-  // the vertex at the end of light segment n makes a path of n + 1, and the shortest caustic
-  // (light -> caster -> receiver -> camera) has 3.
-  if (maxDepth >= 0 && maxDepth < 3) return false;
+  // the vertex at the end of light segment n makes a path of n + 1.
+  if (!reachesCaustics(maxDepth)) return false;
   // A light by power, a point uniformly on it, a direction towards a caster.
   const size_t li = lightChoice_.sample(u.light);
   const AreaLight& light = *lights_[li];

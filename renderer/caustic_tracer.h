@@ -113,6 +113,9 @@ class CausticTracer {
     int x = 0, y = 0;
     Color value{0.0f};
   };
+  // Whether a light path can make a caustic within maxDepth segments, the camera's counted: the
+  // shortest (light -> caster -> receiver -> camera) has 3. The drivers trace none otherwise.
+  static bool reachesCaustics(int maxDepth) { return maxDepth < 0 || maxDepth >= 3; }
   // The path's emission: false if it carries nothing (its direction leaves the emitting side).
   bool start(Sampler& sampler, int index, float pathsPerPixel, int maxDepth, PathState& path) const;
   // start in its steps, for drivers that draw many samplers' numbers together: the numbers, in

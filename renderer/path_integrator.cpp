@@ -35,6 +35,7 @@ bool PathIntegrator::shadowFor(const SurfaceHit& hit, const PathState& path, con
                                          : Ray{hit.offsetOrigin(ls.wi), ls.wi, kInfinity};
   // Field by field: copied whole, GCC built the Ray in a temporary with narrow stores and moved it
   // with wide loads, which waited on those stores (`perf annotate`: a quarter of this function).
+  static_assert(sizeof(Ray) == 2 * sizeof(Vec3) + sizeof(float), "copy every field of Ray");
   shadow.ray.origin = ray.origin;
   shadow.ray.dir = ray.dir;
   shadow.ray.tMax = ray.tMax;

@@ -14,6 +14,7 @@
 #include <cstring>
 #include <limits>
 #include <random>
+#include <string>
 #include <vector>
 
 namespace ember {
@@ -147,6 +148,28 @@ TEST(CausticTracer, SameImageForAnyKernelThreadsAndPassSize) {
   EXPECT_FALSE(identical(reference, without));
   EXPECT_GT(withLight.rays, pathOnly.rays);  // the light paths' rays are counted too
   EXPECT_GT(withLight.shadowRays, pathOnly.shadowRays);
+}
+
+// The light wave against the scalar driver where its steps branch: depth limits that stop the
+// BSDF sample (max_depth 3 and 4), Russian roulette from the first segments, and the independent
+// sampler, whose requests never take the Sobol lanes.
+TEST(CausticTracer, SameImageForAnyKernelAtShortDepthsAndWithEverySampler) {
+  for (const SamplerType sampler : {SamplerType::Sobol, SamplerType::Independent}) {
+    for (const int maxDepth : {3, 4, -1}) {
+      Scene scene = loadScene(test::sourcePath("scenes/cornell-area.json"));
+      scene.settings.width = 23;
+      scene.settings.height = 19;
+      scene.settings.sampler = sampler;
+      scene.settings.maxDepth = maxDepth;
+      scene.settings.rrDepth = 2;
+      scene.build();
+      ASSERT_TRUE(scene.causticTracer().enabled());
+      const std::string what = std::string(sampler == SamplerType::Sobol ? "sobol" : "independent") +
+                               ", max depth " + std::to_string(maxDepth);
+      const Film reference = renderWith(scene, Kernel::Scalar, 1, 4, 2);
+      EXPECT_TRUE(identical(reference, renderWith(scene, Kernel::Wavefront, 2, 4, 2))) << what;
+    }
+  }
 }
 
 }  // namespace

@@ -496,20 +496,28 @@ namespace {
 // live or not, with finite, infinite, zero and negative tfar.
 TEST(PacketTfar, VectorPassesEqualTheScalarLoops) {
   Rng rng(7, 1);
-  const float special[] = {kInfinity, 0.0f, -1.0f, 1e-30f, std::numeric_limits<float>::max(), 3.5f};
+  const float special[] = {kInfinity,
+                           0.0f,
+                           -1.0f,
+                           1e-30f,
+                           std::numeric_limits<float>::max(),
+                           3.5f,
+                           std::numeric_limits<float>::quiet_NaN(),
+                           -kInfinity,
+                           -0.0f,
+                           std::numeric_limits<float>::denorm_min()};
   for (int trial = 0; trial < 200; ++trial) {
     alignas(64) float tfar[kPacketTfarLanes], expected[kPacketTfarLanes];
     alignas(64) int valid[kPacketTfarLanes];
     for (unsigned i = 0; i < kPacketTfarLanes; ++i) {
-      tfar[i] = rng.uniform() < 0.3f ? special[rng.nextU32() % 6] : 100.0f * rng.uniform();
+      tfar[i] = rng.uniform() < 0.3f ? special[rng.nextU32() % 10] : 100.0f * rng.uniform();
       valid[i] = rng.uniform() < 0.5f ? -1 : 0;
     }
     float saved[kPacketTfarLanes], savedExpected[kPacketTfarLanes];
     std::memcpy(expected, tfar, sizeof(tfar));
     for (unsigned i = 0; i < kPacketTfarLanes; ++i) {
       savedExpected[i] = expected[i];
-      if (valid[i] && expected[i] < kInfinity)
-        expected[i] = std::bit_cast<float>(std::bit_cast<uint32_t>(expected[i]) + 1u);
+      if (valid[i]) expected[i] = nextFloatUp(expected[i]);
     }
     widenLiveTfar16(tfar, valid, saved);
     ASSERT_EQ(0, std::memcmp(saved, savedExpected, sizeof(saved))) << "trial " << trial;
