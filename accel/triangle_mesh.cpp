@@ -30,7 +30,7 @@ Vec2 TriangleMesh::uvAt(uint32_t prim, float b1, float b2) const {
 
 Vec3 TriangleMesh::pointAt(uint32_t prim, float b1, float b2) const {
   const glm::uvec3& idx = indices[prim];
-  return (1.0f - b1 - b2) * positions[idx.x] + b1 * positions[idx.y] + b2 * positions[idx.z];
+  return pointOnTriangle(positions[idx.x], positions[idx.y], positions[idx.z], b1, b2);
 }
 
 float TriangleMesh::pointError(uint32_t prim) const {

@@ -22,6 +22,13 @@ class MeshOpacity {
   virtual float coverage(Vec2 uv) const = 0;
 };
 
+// The point at barycentrics (b1, b2) of vertices p1 and p2 of triangle (p0, p1, p2): the one
+// expression every interpolated point uses (TriangleMesh::pointAt, TriangleLight's samples), so
+// that they agree bit for bit.
+inline Vec3 pointOnTriangle(const Vec3& p0, const Vec3& p1, const Vec3& p2, float b1, float b2) {
+  return (1.0f - b1 - b2) * p0 + b1 * p1 + b2 * p2;
+}
+
 struct TriangleMesh {
   std::string name;
   std::vector<Vec3> positions;

@@ -13,7 +13,6 @@
 #include <pmmintrin.h>
 #include <xmmintrin.h>
 
-#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <memory>

@@ -141,8 +141,7 @@ bool TriangleLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
     const Vec2 a = sampleUniformTriangle(u);  // barycentrics of vertices 0 and 1
     b = Vec2(a.y, 1.0f - a.x - a.y);
   }
-  // TriangleMesh::pointAt's expression, on the copied vertices.
-  const Vec3 p = (1.0f - b.x - b.y) * v_[0] + b.x * v_[1] + b.y * v_[2];
+  const Vec3 p = pointOnTriangle(v_[0], v_[1], v_[2], b.x, b.y);
   const Vec3 d = p - ref;
   out.dist = glm::length(d);
   if (out.dist == 0.0f) return false;
