@@ -44,8 +44,8 @@ double peakResidentMb() {
 }
 
 // Resident memory that is the process's own (heap, stacks, Embree's BVH), without the pages of
-// shared libraries: OpenImageIO alone maps ~260 libraries whose touched pages count ~130 MB of
-// RSS before main() runs, shared with every other process that uses them.
+// shared libraries, whose touched pages count in RSS before main() runs and are shared with every
+// other process that uses them.
 double anonymousResidentMb() {
   std::ifstream in("/proc/self/status");
   std::string key;

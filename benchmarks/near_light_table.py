@@ -10,7 +10,7 @@ E = 1/2 sum Theta_i (n . Gamma_i), clipped to the horizon. Without one (the capp
     python3 benchmarks/near_light_table.py build/app/ember [--spp 4096] [--old /path/to/old/ember]
 
 `--old` adds a column for another binary (one without --strategy renders its only estimator, mis).
-Needs only the Python standard library and `oiiotool` (Debian's openimageio-tools)."""
+Needs only the Python standard library (image means come from `ember compare --json`)."""
 import argparse
 import json
 import math
@@ -102,14 +102,11 @@ def scene(emitter, spp, strategy):
     }
 
 
-def average(path, scale=1.0):
-    # oiiotool prints 6 decimals: scale small values up first.
-    args = ["oiiotool", path, "--mulc", repr(scale), "--printstats"]
-    out = subprocess.run(args, capture_output=True, text=True, check=True).stdout
-    for line in out.splitlines():
-        if "Stats Avg" in line:
-            return float(line.split(":")[1].split()[0]) / scale
-    raise RuntimeError("no stats for " + path)
+def average(ember, path):
+    # The image against itself: the comparison's mean of each channel, at full double precision.
+    out = subprocess.run([ember, "compare", path, path, "--json"], capture_output=True, text=True, check=True).stdout
+    means = json.loads(out)["mean_image"]
+    return sum(means) / len(means)
 
 
 def measure(ember, emitter, spp, strategy, tmp):
@@ -120,7 +117,7 @@ def measure(ember, emitter, spp, strategy, tmp):
             "--sampler", "independent", "-q"]
     subprocess.run(args, check=True, capture_output=True)
     # Mean of the 16 pixel means, and its standard error from their variances.
-    return average(os.path.join(tmp, "m.exr"), 1e3), math.sqrt(average(os.path.join(tmp, "v.exr"), 1e12) / 16)
+    return average(ember, os.path.join(tmp, "m.exr")), math.sqrt(average(ember, os.path.join(tmp, "v.exr")) / 16)
 
 
 def main():

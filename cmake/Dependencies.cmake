@@ -1,7 +1,7 @@
 # All dependencies come from Debian 12 packages (scripts/setup-deps.sh installs them).
 # Versions and quirks: ../shared/docs/debian-toolchain.md.
 find_package(embree 3.13 REQUIRED CONFIG)
-find_package(OpenImageIO 2.4 REQUIRED CONFIG)
+find_package(OpenEXR 3.1 REQUIRED CONFIG)  # EXR files: renders, references, HDR textures
 find_package(TinyGLTF REQUIRED CONFIG)
 find_package(glm REQUIRED CONFIG)
 find_package(TBB REQUIRED CONFIG)
@@ -14,8 +14,5 @@ find_package(PkgConfig REQUIRED)
 find_package(MPI COMPONENTS CXX QUIET)
 pkg_check_modules(xxhash REQUIRED IMPORTED_TARGET libxxhash)  # content hashes of checkpointed scenes
 find_package(hwy 1.0 REQUIRED CONFIG)  # Highway: SIMD with run-time dispatch (accel/shape_lanes.cpp)
-
-# Quirk 1: OIIO's exported target names /usr/include/opencv4, which is absent without libopencv-dev.
-get_target_property(_ember_oiio_inc OpenImageIO::OpenImageIO INTERFACE_INCLUDE_DIRECTORIES)
-list(FILTER _ember_oiio_inc EXCLUDE REGEX "opencv")
-set_target_properties(OpenImageIO::OpenImageIO PROPERTIES INTERFACE_INCLUDE_DIRECTORIES "${_ember_oiio_inc}")
+# stb_image and stb_image_write (libstb-dev): PNG, JPEG and other 8/16-bit textures in, PNG out.
+pkg_check_modules(stb REQUIRED IMPORTED_TARGET stb)

@@ -4,58 +4,140 @@
 #include "io/pending_file.h"
 #include "materials/texture.h"
 
-#include <OpenImageIO/imageio.h>
-#include <unistd.h>
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+#include <ImfStandardAttributes.h>
+#include <ImfStringAttribute.h>
+#include <ImfTestFile.h>
+#include <stb_image.h>
+#include <stb_image_write.h>
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <memory>
 
 namespace ember {
 
 namespace {
 
+// An image file's pixels as floats, `channels` per pixel, rows from the top.
 struct RawPixels {
-  int width, height, channels;
-  OIIO::TypeDesc format;
+  int width = 0, height = 0, channels = 0;
+  bool integer = false;  // stored as 8- or 16-bit integers (then sRGB-encoded unless told otherwise)
   std::vector<float> data;
 };
 
-RawPixels readRaw(const std::string& path) {
+void checkExists(const std::string& path) {
   if (!std::filesystem::exists(path)) throw InputError(path + ": no such file");
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) throw InputError(path + ": cannot read image: " + OIIO::geterror());
-  const OIIO::ImageSpec& spec = in->spec();
-  RawPixels raw{spec.width, spec.height, spec.nchannels, spec.format, {}};
+}
+
+// The channels an EXR's pixels are read from: R, G and B when it has any of them (a missing one
+// reads as 0), else Y (luminance), else its first channel, read as grey.
+std::vector<std::string> exrColourChannels(const Imf::ChannelList& channels) {
+  if (channels.findChannel("R") || channels.findChannel("G") || channels.findChannel("B"))
+    return {"R", "G", "B"};
+  if (channels.findChannel("Y")) return {"Y"};
+  if (channels.begin() != channels.end()) return {channels.begin().name()};
+  return {};
+}
+
+RawPixels readExr(const std::string& path) {
+  try {
+    Imf::InputFile file(path.c_str());
+    const Imath::Box2i window = file.header().dataWindow();
+    const int64_t width = int64_t(window.max.x) - window.min.x + 1,
+                  height = int64_t(window.max.y) - window.min.y + 1;
+    if (width <= 0 || height <= 0 || width > std::numeric_limits<int>::max() ||
+        height > std::numeric_limits<int>::max())
+      throw InputError(path + ": image has no pixels");
+    const std::vector<std::string> names = exrColourChannels(file.header().channels());
+    if (names.empty()) throw InputError(path + ": image has no channels");
+    RawPixels raw{int(width), int(height), int(names.size()), false, {}};
+    raw.data.resize(size_t(width) * size_t(height) * names.size());
+    Imf::FrameBuffer frame;
+    const size_t xStride = names.size() * sizeof(float), yStride = xStride * size_t(width);
+    for (size_t c = 0; c < names.size(); ++c)
+      frame.insert(names[c], Imf::Slice::Make(Imf::FLOAT, raw.data.data() + c, window, xStride, yStride));
+    file.setFrameBuffer(frame);
+    file.readPixels(window.min.y, window.max.y);
+    return raw;
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {  // OpenEXR's exceptions (Iex) and std::bad_alloc
+    throw InputError(path + ": cannot read image: " + e.what());
+  }
+}
+
+std::vector<unsigned char> fileBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open");
+  std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (bytes.size() > size_t(std::numeric_limits<int>::max()))
+    throw InputError(path + ": image file too large");
+  return bytes;
+}
+
+// PNG, JPEG, BMP, TGA, PSD, GIF, PNM and Radiance HDR through stb_image: 8- and 16-bit files as
+// integers scaled to [0, 1], HDR files as their floats.
+RawPixels readStb(const std::string& path) {
+  const std::vector<unsigned char> bytes = fileBytes(path);
+  const auto* data = bytes.data();
+  const int size = int(bytes.size());
+  RawPixels raw;
+  const auto fail = [&]() {
+    return InputError(path +
+                      ": cannot read image: " + (stbi_failure_reason() ? stbi_failure_reason() : "unknown"));
+  };
+  if (!stbi_info_from_memory(data, size, &raw.width, &raw.height, &raw.channels)) throw fail();
   if (raw.width <= 0 || raw.height <= 0 || raw.channels <= 0)
     throw InputError(path + ": image has no pixels");
-  raw.data.resize(size_t(raw.width) * size_t(raw.height) * size_t(raw.channels));
-  if (!in->read_image(0, 0, 0, raw.channels, OIIO::TypeDesc::FLOAT, raw.data.data()))
-    throw InputError(path + ": cannot decode image: " + in->geterror());
-  in->close();
+  const size_t count = size_t(raw.width) * size_t(raw.height) * size_t(raw.channels);
+  int w = 0, h = 0, n = 0;
+  if (stbi_is_hdr_from_memory(data, size)) {
+    const std::unique_ptr<float, decltype(&stbi_image_free)> px(
+        stbi_loadf_from_memory(data, size, &w, &h, &n, 0), &stbi_image_free);
+    if (!px) throw fail();
+    raw.data.assign(px.get(), px.get() + count);
+  } else if (stbi_is_16_bit_from_memory(data, size)) {
+    const std::unique_ptr<stbi_us, decltype(&stbi_image_free)> px(
+        stbi_load_16_from_memory(data, size, &w, &h, &n, 0), &stbi_image_free);
+    if (!px) throw fail();
+    raw.integer = true;
+    raw.data.resize(count);
+    for (size_t i = 0; i < count; ++i) raw.data[i] = float(px.get()[i]) / 65535.0f;
+  } else {
+    const std::unique_ptr<stbi_uc, decltype(&stbi_image_free)> px(
+        stbi_load_from_memory(data, size, &w, &h, &n, 0), &stbi_image_free);
+    if (!px) throw fail();
+    raw.integer = true;
+    raw.data.resize(count);
+    for (size_t i = 0; i < count; ++i) raw.data[i] = float(px.get()[i]) / 255.0f;
+  }
+  if (w != raw.width || h != raw.height || n != raw.channels)
+    throw InputError(path + ": image changed size while decoding");
   return raw;
+}
+
+RawPixels readRaw(const std::string& path) {
+  checkExists(path);
+  return Imf::isOpenExrFile(path.c_str()) ? readExr(path) : readStb(path);
 }
 
 Color pixelRgb(const float* p, int channels) {
   return channels >= 3 ? Color(p[0], p[1], p[2]) : Color(p[0]);
 }
 
-void writeWithOiio(const std::string& path, const OIIO::ImageSpec& spec, OIIO::TypeDesc type,
-                   const void* pixels) {
-  auto out = OIIO::ImageOutput::create(path);
-  if (!out) throw std::runtime_error(path + ": cannot create image writer: " + OIIO::geterror());
-  if (!out->open(path, spec))
-    throw std::runtime_error(path + ": cannot open for writing: " + out->geterror());
-  if (!out->write_image(type, pixels)) throw std::runtime_error(path + ": write failed: " + out->geterror());
-  if (!out->close()) throw std::runtime_error(path + ": close failed: " + out->geterror());
-}
-
 }  // namespace
 
 TextureImage readTexture(const std::string& path, ColorEncoding encoding) {
   const RawPixels raw = readRaw(path);
-  const bool integer =
-      raw.format.basetype == OIIO::TypeDesc::UINT8 || raw.format.basetype == OIIO::TypeDesc::UINT16;
-  const bool srgb = encoding == ColorEncoding::Srgb || (encoding == ColorEncoding::Auto && integer);
+  const bool srgb = encoding == ColorEncoding::Srgb || (encoding == ColorEncoding::Auto && raw.integer);
   TextureImage tex{raw.width, raw.height, {}};
   tex.texels.resize(size_t(raw.width) * size_t(raw.height));
   for (size_t i = 0; i < tex.texels.size(); ++i) {
@@ -91,30 +173,50 @@ Image readImageRgb(const std::string& path) {
 }
 
 Metadata readStringMetadata(const std::string& path) {
-  if (!std::filesystem::exists(path)) throw InputError(path + ": no such file");
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) throw InputError(path + ": cannot read image: " + OIIO::geterror());
-  Metadata out;
-  for (const OIIO::ParamValue& p : in->spec().extra_attribs)
-    if (p.type() == OIIO::TypeDesc::STRING) out.emplace_back(p.name().string(), p.get_string());
-  in->close();
-  return out;
+  checkExists(path);
+  if (!Imf::isOpenExrFile(path.c_str())) {
+    readRaw(path);  // an unreadable file is an error here too; other formats carry no metadata we read
+    return {};
+  }
+  try {
+    Imf::InputFile file(path.c_str());
+    Metadata out;
+    for (auto it = file.header().begin(); it != file.header().end(); ++it)
+      if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
+        out.emplace_back(it.name(), s->value());
+    return out;
+  } catch (const std::exception& e) {
+    throw InputError(path + ": cannot read image: " + e.what());
+  }
 }
 
 void writeExr(const std::string& path, const Image& image, const Metadata& metadata) {
   writeAtomically(path, [&](const std::string& tmp) {
-    OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::FLOAT);
-    spec.channelnames = {"R", "G", "B"};
-    spec.attribute("compression", "zip");
-    for (const auto& [key, value] : metadata) spec.attribute(key, value);
-    writeWithOiio(tmp, spec, OIIO::TypeDesc::FLOAT, image.rgb.data());
+    try {
+      Imf::Header header(image.width, image.height);
+      header.compression() = Imf::ZIP_COMPRESSION;
+      for (const char* name : {"R", "G", "B"}) header.channels().insert(name, Imf::Channel(Imf::FLOAT));
+      for (const auto& [key, value] : metadata) header.insert(key, Imf::StringAttribute(value));
+      Imf::FrameBuffer frame;
+      const size_t xStride = 3 * sizeof(float), yStride = xStride * size_t(image.width);
+      // OpenEXR's slices take a non-const base pointer, but an output file only reads through it.
+      char* base = reinterpret_cast<char*>(const_cast<float*>(image.rgb.data()));
+      frame.insert("R", Imf::Slice(Imf::FLOAT, base, xStride, yStride));
+      frame.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xStride, yStride));
+      frame.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xStride, yStride));
+      Imf::OutputFile file(tmp.c_str(), header);
+      file.setFrameBuffer(frame);
+      file.writePixels(image.height);
+    } catch (const std::exception& e) {
+      throw std::runtime_error(path + ": cannot write EXR: " + e.what());
+    }
   });
 }
 
 void writePng(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb8) {
   writeAtomically(path, [&](const std::string& tmp) {
-    OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
-    writeWithOiio(tmp, spec, OIIO::TypeDesc::UINT8, rgb8.data());
+    if (!stbi_write_png(tmp.c_str(), width, height, 3, rgb8.data(), width * 3))
+      throw std::runtime_error(path + ": cannot write PNG");
   });
 }
 

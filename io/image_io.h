@@ -1,6 +1,7 @@
-// Image files through OpenImageIO: textures in, linear float EXR and 8-bit PNG out. Every output is
-// written to a temporary file in the destination folder and renamed into place, so a failed or
-// interrupted run never leaves a half-written image under the requested name.
+// Image files: textures in, linear float EXR and 8-bit PNG out. EXR through OpenEXR; PNG, JPEG,
+// BMP, TGA, PSD, GIF, PNM and Radiance HDR through stb_image (in) and stb_image_write (PNG out).
+// Every output is written to a temporary file in the destination folder and renamed into place,
+// so a failed or interrupted run never leaves a half-written image under the requested name.
 #pragma once
 
 #include "renderer/film.h"
@@ -20,18 +21,19 @@ struct TextureImage {
   std::vector<Color> texels;  // linear, row 0 = first row of the file
 };
 
-// Reads any format OIIO knows. Auto decodes 8- and 16-bit integer files from sRGB and keeps float
-// files (EXR, HDR) linear. One or two channels are read as grey.
+// Reads any of the formats above, told apart by their contents, not their names. Auto decodes 8-
+// and 16-bit integer files from sRGB and keeps float files (EXR, HDR) linear. One or two channels
+// are read as grey; an EXR is read from its R, G, B channels, else Y, else its first channel.
 TextureImage readTexture(const std::string& path, ColorEncoding encoding);
 // Same, from pixels already decoded to 8 bits per channel (e.g. by tinygltf).
 TextureImage textureFromBytes(const uint8_t* data, int width, int height, int channels, bool srgb);
 
-// The first three channels of an image file as linear float RGB (no colour decoding).
+// An image file as linear float RGB, its channels chosen as readTexture's (no colour decoding).
 Image readImageRgb(const std::string& path);
 
 using Metadata = std::vector<std::pair<std::string, std::string>>;
 void writeExr(const std::string& path, const Image& image, const Metadata& metadata = {});
-// The string attributes of an image file's header (an EXR's ember:* metadata).
+// The string attributes of an EXR's header (its ember:* metadata); none for other formats.
 Metadata readStringMetadata(const std::string& path);
 void writePng(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb8);
 

@@ -5,7 +5,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config
-  libembree-dev libhwy-dev libxxhash-dev libopenimageio-dev openimageio-tools libopenexr-dev libimath-dev
+  libembree-dev libhwy-dev libxxhash-dev libopenexr-dev libimath-dev
   libtinygltf-dev libstb-dev libglm-dev libtbb-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libbenchmark-dev libfmt-dev assimp-testmodels
   libopenmpi-dev openmpi-bin clang-14 libclang-rt-14-dev

@@ -5,8 +5,17 @@
 #include "materials/texture.h"
 #include "test_paths.h"
 
-#include <OpenImageIO/imageio.h>
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+#include <ImfStringAttribute.h>
 #include <gtest/gtest.h>
+#include <half.h>
+#include <stb_image_write.h>
+
+#include <fstream>
 
 namespace ember {
 namespace {
@@ -24,11 +33,18 @@ TEST(ImageIo, ExrRoundTripIsExactAndCarriesMetadata) {
   ASSERT_EQ(back.width, 5);
   ASSERT_EQ(back.height, 3);
   EXPECT_EQ(back.rgb, img.rgb);  // float32, lossless compression: bit-exact
-  auto in = OIIO::ImageInput::open(path);
-  ASSERT_TRUE(in);
-  EXPECT_EQ(in->spec().get_string_attribute("ember:spp"), "17");
-  EXPECT_EQ(in->spec().format, OIIO::TypeDesc::FLOAT);
-  EXPECT_EQ(in->spec().nchannels, 3);
+  EXPECT_EQ(readStringMetadata(path), (Metadata{{"ember:spp", "17"}}));
+  // What other tools see: float R, G, B, and the metadata as a string attribute.
+  Imf::InputFile in(path.c_str());
+  const auto* spp = in.header().findTypedAttribute<Imf::StringAttribute>("ember:spp");
+  ASSERT_NE(spp, nullptr);
+  EXPECT_EQ(spp->value(), "17");
+  int channels = 0;
+  for (auto c = in.header().channels().begin(); c != in.header().channels().end(); ++c, ++channels)
+    EXPECT_EQ(c.channel().type, Imf::FLOAT) << c.name();
+  EXPECT_EQ(channels, 3);
+  EXPECT_NE(in.header().channels().findChannel("R"), nullptr);
+  EXPECT_NE(in.header().channels().findChannel("B"), nullptr);
   // Only the final file is left: the temporary was renamed.
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path), {}), 1);
 }
@@ -73,6 +89,110 @@ TEST(ImageIo, MissingAndCorruptTexturesAreInputErrors) {
   EXPECT_THROW(readTexture(dir.file("none.png"), ColorEncoding::Auto), InputError);
   const std::string bad = dir.write("bad.png", "this is not a png");
   EXPECT_THROW(readTexture(bad, ColorEncoding::Auto), InputError);
+}
+
+// An EXR of half-float channels `names` (values[c] for channel c, row by row) over a data window
+// that does not start at the origin, as other tools write them.
+void writeHalfExr(const std::string& path, const std::vector<std::string>& names,
+                  const std::vector<std::vector<float>>& values, int width, int height) {
+  const Imath::Box2i window({10, 20}, {10 + width - 1, 20 + height - 1});
+  Imf::Header header(window, window);
+  for (const auto& name : names) header.channels().insert(name, Imf::Channel(Imf::HALF));
+  std::vector<std::vector<half>> planes;
+  for (const auto& v : values) planes.emplace_back(v.begin(), v.end());
+  Imf::FrameBuffer frame;
+  for (size_t c = 0; c < names.size(); ++c)
+    frame.insert(names[c], Imf::Slice::Make(Imf::HALF, planes[c].data(), window));
+  Imf::OutputFile file(path.c_str(), header);
+  file.setFrameBuffer(frame);
+  file.writePixels(height);
+}
+
+TEST(ImageIo, ExrFromOtherToolsHalfGreyAndOffsetWindows) {
+  TempDir dir;
+  // Half floats over a window at (10, 20): values exact in half, read linear (no sRGB decoding).
+  const std::string rgb = dir.file("rgb.exr");
+  writeHalfExr(rgb, {"R", "G", "B", "A"},
+               {{0.5f, 2.0f, 0.25f}, {1.0f, 0.0f, 3.0f}, {0.125f, 8.0f, 1.5f}, {1, 1, 1}}, 3, 1);
+  const TextureImage t = readTexture(rgb, ColorEncoding::Auto);
+  ASSERT_EQ(t.width, 3);
+  ASSERT_EQ(t.height, 1);
+  EXPECT_EQ(t.texels[0], Color(0.5f, 1.0f, 0.125f));
+  EXPECT_EQ(t.texels[1], Color(2.0f, 0.0f, 8.0f));
+  EXPECT_EQ(t.texels[2], Color(0.25f, 3.0f, 1.5f));
+  // Luminance alone is grey; a file without G reads it as 0.
+  const std::string grey = dir.file("y.exr");
+  writeHalfExr(grey, {"Y"}, {{0.75f, 4.0f}}, 1, 2);
+  const Image g = readImageRgb(grey);
+  ASSERT_EQ(g.height, 2);
+  EXPECT_EQ(g.at(0, 1), Color(4.0f));
+  const std::string rb = dir.file("rb.exr");
+  writeHalfExr(rb, {"R", "B"}, {{1.0f}, {2.0f}}, 1, 1);
+  EXPECT_EQ(readImageRgb(rb).at(0, 0), Color(1.0f, 0.0f, 2.0f));
+  EXPECT_TRUE(readStringMetadata(rb).empty() || readStringMetadata(rb)[0].first != "ember:spp");
+}
+
+TEST(ImageIo, IntegerFormatsDecodeFromSrgbAndHdrStaysLinear) {
+  TempDir dir;
+  // 8-bit PNG, BMP and TGA: exact bytes, decoded from sRGB by Auto, kept by Linear.
+  const uint8_t rgb[6] = {0, 128, 255, 64, 32, 16};
+  for (const char* name : {"a.png", "a.bmp", "a.tga"}) {
+    const std::string path = dir.file(name);
+    const std::string ext = std::filesystem::path(path).extension().string();
+    const int ok = ext == ".png"   ? stbi_write_png(path.c_str(), 2, 1, 3, rgb, 6)
+                   : ext == ".bmp" ? stbi_write_bmp(path.c_str(), 2, 1, 3, rgb)
+                                   : stbi_write_tga(path.c_str(), 2, 1, 3, rgb);
+    ASSERT_TRUE(ok) << name;
+    const TextureImage lin = readTexture(path, ColorEncoding::Linear);
+    EXPECT_EQ(lin.texels[0], Color(0.0f, 128.0f / 255.0f, 1.0f)) << name;
+    EXPECT_EQ(lin.texels[1], Color(64.0f, 32.0f, 16.0f) / 255.0f) << name;
+    const TextureImage srgb = readTexture(path, ColorEncoding::Auto);
+    EXPECT_NEAR(srgb.texels[0].y, srgbToLinear(128.0f / 255.0f), 1e-7f) << name;
+  }
+  // 16 bits per channel, grey (tests/data/images/grey16.png: rows 0, 65535 and 1000, 40000).
+  const TextureImage g16 =
+      readTexture(test::sourcePath("tests/data/images/grey16.png"), ColorEncoding::Linear);
+  ASSERT_EQ(g16.width, 2);
+  ASSERT_EQ(g16.height, 2);
+  EXPECT_EQ(g16.texels[1], Color(1.0f));
+  EXPECT_EQ(g16.texels[2], Color(1000.0f / 65535.0f));
+  EXPECT_EQ(g16.texels[3], Color(40000.0f / 65535.0f));
+  // Radiance HDR is linear under Auto; these values survive its shared exponent exactly.
+  const float hdr[6] = {0.5f, 0.25f, 0.125f, 8.0f, 4.0f, 2.0f};
+  const std::string path = dir.file("a.hdr");
+  ASSERT_TRUE(stbi_write_hdr(path.c_str(), 2, 1, 3, hdr));
+  const TextureImage h = readTexture(path, ColorEncoding::Auto);
+  EXPECT_EQ(h.texels[0], Color(0.5f, 0.25f, 0.125f));
+  EXPECT_EQ(h.texels[1], Color(8.0f, 4.0f, 2.0f));
+  // The PNG writer's output reads back byte for byte.
+  const std::string png = dir.file("out.png");
+  writePng(png, 2, 1, std::vector<uint8_t>(rgb, rgb + 6));
+  EXPECT_EQ(readTexture(png, ColorEncoding::Linear).texels[1], Color(64.0f, 32.0f, 16.0f) / 255.0f);
+}
+
+TEST(ImageIo, CorruptAndTruncatedImagesNameTheFile) {
+  TempDir dir;
+  // An EXR's magic number followed by garbage, and a PNG cut in half.
+  const std::string exr = dir.write("bad.exr", std::string("\x76\x2f\x31\x01", 4) + std::string(100, 'x'));
+  const std::string cut = dir.file("cut.png");
+  {
+    const std::string whole = dir.file("whole.png");
+    std::vector<uint8_t> px(64 * 64 * 3, 200);
+    ASSERT_TRUE(stbi_write_png(whole.c_str(), 64, 64, 3, px.data(), 64 * 3));
+    std::ifstream in(whole, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    dir.write("cut.png", bytes.substr(0, bytes.size() / 2));
+  }
+  for (const std::string& path : {exr, cut}) {
+    try {
+      readImageRgb(path);
+      ADD_FAILURE() << path << " was read";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(readTexture(path, ColorEncoding::Auto), InputError) << path;
+    EXPECT_THROW(readStringMetadata(path), InputError) << path;
+  }
 }
 
 }  // namespace
