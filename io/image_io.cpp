@@ -15,12 +15,17 @@
 #include <stb_image.h>
 #include <stb_image_write.h>
 
+#include <bit>
+#include <cctype>
+#include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <limits>
 #include <memory>
+#include <sstream>
 
 namespace ember {
 
@@ -85,8 +90,7 @@ std::vector<unsigned char> fileBytes(const std::string& path) {
 
 // PNG, JPEG, BMP, TGA, PSD, GIF, PNM and Radiance HDR through stb_image: 8- and 16-bit files as
 // integers scaled to [0, 1], HDR files as their floats.
-RawPixels readStb(const std::string& path) {
-  const std::vector<unsigned char> bytes = fileBytes(path);
+RawPixels readStb(const std::string& path, const std::vector<unsigned char>& bytes) {
   const auto* data = bytes.data();
   const int size = int(bytes.size());
   RawPixels raw;
@@ -124,9 +128,49 @@ RawPixels readStb(const std::string& path) {
   return raw;
 }
 
+// Portable float map (PFM), as pbrt and Mitsuba read it: "PF" (RGB) or "Pf" (grey), the width and
+// height, then a scale whose sign gives the byte order (negative: little-endian), then the floats,
+// rows from the bottom of the image.
+bool isPfm(const std::vector<unsigned char>& bytes) {
+  return bytes.size() >= 3 && bytes[0] == 'P' && (bytes[1] == 'F' || bytes[1] == 'f') &&
+         std::isspace(bytes[2]);
+}
+
+RawPixels readPfm(const std::string& path, const std::vector<unsigned char>& bytes) {
+  const std::string head(bytes.begin(), bytes.begin() + ptrdiff_t(std::min<size_t>(bytes.size(), 256)));
+  std::istringstream in(head);
+  std::string magic;
+  int64_t width = 0, height = 0;
+  double scale = 0.0;
+  if (!(in >> magic >> width >> height >> scale) || !std::isspace(in.get()))
+    throw InputError(path + ": PFM header is malformed");
+  if (width <= 0 || height <= 0 || width > (1 << 20) || height > (1 << 20) || !std::isfinite(scale) ||
+      scale == 0.0)
+    throw InputError(path + ": PFM header gives an invalid size or scale");
+  const int channels = magic == "PF" ? 3 : 1;
+  const size_t count = size_t(width) * size_t(height) * size_t(channels);
+  const size_t offset = size_t(in.tellg());
+  if (bytes.size() - offset < count * sizeof(float))
+    throw InputError(path + ": PFM file is shorter than its header says (" + std::to_string(width) + "x" +
+                     std::to_string(height) + ")");
+  const bool fileLittle = scale < 0.0, hostLittle = std::endian::native == std::endian::little;
+  RawPixels raw{int(width), int(height), channels, false, std::vector<float>(count)};
+  const size_t row = size_t(width) * size_t(channels);
+  for (size_t y = 0; y < size_t(height); ++y)
+    for (size_t i = 0; i < row; ++i) {
+      uint32_t bits = 0;
+      std::memcpy(&bits, &bytes[offset + ((size_t(height) - 1 - y) * row + i) * sizeof(float)], sizeof bits);
+      if (fileLittle != hostLittle) bits = __builtin_bswap32(bits);
+      std::memcpy(&raw.data[y * row + i], &bits, sizeof bits);
+    }
+  return raw;
+}
+
 RawPixels readRaw(const std::string& path) {
   checkExists(path);
-  return Imf::isOpenExrFile(path.c_str()) ? readExr(path) : readStb(path);
+  if (Imf::isOpenExrFile(path.c_str())) return readExr(path);
+  const std::vector<unsigned char> bytes = fileBytes(path);
+  return isPfm(bytes) ? readPfm(path, bytes) : readStb(path, bytes);
 }
 
 Color pixelRgb(const float* p, int channels) {

@@ -1,5 +1,6 @@
 // Image files: textures in, linear float EXR and 8-bit PNG out. EXR through OpenEXR; PNG, JPEG,
-// BMP, TGA, PSD, GIF, PNM and Radiance HDR through stb_image (in) and stb_image_write (PNG out).
+// BMP, TGA, PSD, GIF, PNM and Radiance HDR through stb_image (in) and stb_image_write (PNG out);
+// PFM (portable float map) read here.
 // Every output is written to a temporary file in the destination folder and renamed into place,
 // so a failed or interrupted run never leaves a half-written image under the requested name.
 #pragma once
@@ -22,7 +23,7 @@ struct TextureImage {
 };
 
 // Reads any of the formats above, told apart by their contents, not their names. Auto decodes 8-
-// and 16-bit integer files from sRGB and keeps float files (EXR, HDR) linear. One or two channels
+// and 16-bit integer files from sRGB and keeps float files (EXR, HDR, PFM) linear. One or two channels
 // are read as grey; an EXR is read from its R, G, B channels, else Y, else its first channel.
 TextureImage readTexture(const std::string& path, ColorEncoding encoding);
 // Same, from pixels already decoded to 8 bits per channel (e.g. by tinygltf).

@@ -15,6 +15,7 @@
 #include <half.h>
 #include <stb_image_write.h>
 
+#include <cstring>
 #include <fstream>
 
 namespace ember {
@@ -168,6 +169,40 @@ TEST(ImageIo, IntegerFormatsDecodeFromSrgbAndHdrStaysLinear) {
   const std::string png = dir.file("out.png");
   writePng(png, 2, 1, std::vector<uint8_t>(rgb, rgb + 6));
   EXPECT_EQ(readTexture(png, ColorEncoding::Linear).texels[1], Color(64.0f, 32.0f, 16.0f) / 255.0f);
+}
+
+// A PFM file: its rows bottom-up, its floats in the byte order its scale's sign gives.
+std::string pfm(const char* magic, int width, int height, bool littleEndian,
+                const std::vector<float>& bottomUp) {
+  std::string s = std::string(magic) + "\n" + std::to_string(width) + " " + std::to_string(height) + "\n" +
+                  (littleEndian ? "-1.0" : "1.0") + "\n";
+  for (const float v : bottomUp) {
+    uint32_t bits;
+    std::memcpy(&bits, &v, 4);
+    for (int k = 0; k < 4; ++k) s += char(littleEndian ? bits >> (8 * k) : bits >> (8 * (3 - k)));
+  }
+  return s;
+}
+
+TEST(ImageIo, PfmBothByteOrdersRowsFromTheBottom) {
+  TempDir dir;
+  for (const bool little : {true, false}) {
+    // 1 x 2 RGB: the bottom row (written first) is (1, 2, 3), the top one (0.5, 0.25, 1e-3).
+    const std::string rgb =
+        dir.write("rgb.pfm", pfm("PF", 1, 2, little, {1.0f, 2.0f, 3.0f, 0.5f, 0.25f, 1e-3f}));
+    const TextureImage t = readTexture(rgb, ColorEncoding::Auto);  // linear: a float format
+    ASSERT_EQ(t.width, 1);
+    ASSERT_EQ(t.height, 2);
+    EXPECT_EQ(t.texels[0], Color(0.5f, 0.25f, 1e-3f)) << little;
+    EXPECT_EQ(t.texels[1], Color(1.0f, 2.0f, 3.0f)) << little;
+    const std::string grey = dir.write("grey.pfm", pfm("Pf", 2, 1, little, {7.0f, 0.125f}));
+    EXPECT_EQ(readImageRgb(grey).at(1, 0), Color(0.125f)) << little;
+  }
+  // A file shorter than its header says, and a header without a size.
+  std::string cut = pfm("PF", 4, 4, true, std::vector<float>(47, 1.0f));
+  EXPECT_THROW(readTexture(dir.write("cut.pfm", cut), ColorEncoding::Auto), InputError);
+  EXPECT_THROW(readTexture(dir.write("bad.pfm", "PF\nx y\n-1\n"), ColorEncoding::Auto), InputError);
+  EXPECT_THROW(readTexture(dir.write("huge.pfm", "PF\n-3 2\n-1\n"), ColorEncoding::Auto), InputError);
 }
 
 TEST(ImageIo, CorruptAndTruncatedImagesNameTheFile) {
