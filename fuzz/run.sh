@@ -8,10 +8,10 @@ seconds=${1:-30}
 jobs=$(nproc)
 CXX=${CXX:-clang++-14} cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DEMBER_FUZZ=ON \
   -DEMBER_BUILD_TESTS=OFF >/dev/null
-cmake --build build-fuzz -j "$jobs" --target fuzz_scene_json fuzz_gltf fuzz_checkpoint ember
+cmake --build build-fuzz -j "$jobs" --target fuzz_scene_json fuzz_gltf fuzz_checkpoint fuzz_image ember
 
 corpus=build-fuzz/corpus
-mkdir -p "$corpus"/{scene_json,gltf,checkpoint}
+mkdir -p "$corpus"/{scene_json,gltf,checkpoint,image}
 # Seeds: Ember's own scenes; glTF files of every kind, valid and deliberately broken (Debian's
 # assimp-testmodels, the generated showcases, the Khronos samples beside a checkout); a real
 # checkpoint. Copied, so the fuzzer's new inputs never land in the source tree.
@@ -26,10 +26,16 @@ find "${seed_dirs[@]}" \( -name '*.gltf' -o -name '*.glb' \) \
   -size -2M 2>/dev/null | while read -r f; do cp "$f" "$corpus/gltf/$(echo "$f" | md5sum | cut -c1-16)$(basename "$f" | sed 's/.*\(\.gl[tb]f*\)$/\1/')"; done
 ASAN_OPTIONS=detect_leaks=0 build-fuzz/app/ember render scenes/cornell-area.json -o "$corpus/seed.exr" --width 8 \
   --height 6 --spp 2 -q --checkpoint "$corpus/checkpoint/seed.ckpt" 2>/dev/null
-rm -f "$corpus/seed.exr"
+# Images: the reference EXRs (written by Mitsuba), Ember's own EXR and PNG outputs, the checker
+# texture, a 16-bit PNG, the glTF showcases' half-float EXR environment maps, and a PFM.
+cp tests/data/images/*.png scenes/*.png "$corpus/image/"
+find tests/data -name '*.exr' -size -1M | while read -r f; do cp "$f" "$corpus/image/$(echo "$f" | md5sum | cut -c1-16).exr"; done
+find scenes -name '*.exr' -size -1M | while read -r f; do cp "$f" "$corpus/image/$(echo "$f" | md5sum | cut -c1-16).exr"; done
+mv "$corpus/seed.exr" "$corpus/image/ember.exr"
+printf 'PF\n1 1\n-1.0\n\0\0\200?\0\0\0@\0\0@@' > "$corpus/image/tiny.pfm"
 
 status=0
-for target in scene_json gltf checkpoint; do
+for target in scene_json gltf checkpoint image; do
   echo "fuzz_$target: ${seconds}s from $(ls "$corpus/$target" | wc -l) seeds"
   if ! ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
       "build-fuzz/fuzz/fuzz_$target" "$corpus/$target" -max_total_time="$seconds" -timeout=20 \

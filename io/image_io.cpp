@@ -42,6 +42,17 @@ void checkExists(const std::string& path) {
   if (!std::filesystem::exists(path)) throw InputError(path + ": no such file");
 }
 
+// At most 16384 x 16384 pixels (3 GB as float RGB): a header that claims more is rejected before
+// anything of its size is allocated.
+constexpr int64_t kMaxPixels = int64_t(1) << 28;
+
+void checkSize(const std::string& path, int64_t width, int64_t height) {
+  if (width <= 0 || height <= 0) throw InputError(path + ": image has no pixels");
+  if (width > kMaxPixels || height > kMaxPixels || width * height > kMaxPixels)
+    throw InputError(path + ": image of " + std::to_string(width) + " x " + std::to_string(height) +
+                     " pixels is larger than Ember reads (2^28 pixels)");
+}
+
 // The channels an EXR's pixels are read from: R, G and B when it has any of them (a missing one
 // reads as 0), else Y (luminance), else its first channel, read as grey.
 std::vector<std::string> exrColourChannels(const Imf::ChannelList& channels) {
@@ -58,9 +69,7 @@ RawPixels readExr(const std::string& path) {
     const Imath::Box2i window = file.header().dataWindow();
     const int64_t width = int64_t(window.max.x) - window.min.x + 1,
                   height = int64_t(window.max.y) - window.min.y + 1;
-    if (width <= 0 || height <= 0 || width > std::numeric_limits<int>::max() ||
-        height > std::numeric_limits<int>::max())
-      throw InputError(path + ": image has no pixels");
+    checkSize(path, width, height);
     const std::vector<std::string> names = exrColourChannels(file.header().channels());
     if (names.empty()) throw InputError(path + ": image has no channels");
     RawPixels raw{int(width), int(height), int(names.size()), false, {}};
@@ -99,8 +108,8 @@ RawPixels readStb(const std::string& path, const std::vector<unsigned char>& byt
                       ": cannot read image: " + (stbi_failure_reason() ? stbi_failure_reason() : "unknown"));
   };
   if (!stbi_info_from_memory(data, size, &raw.width, &raw.height, &raw.channels)) throw fail();
-  if (raw.width <= 0 || raw.height <= 0 || raw.channels <= 0)
-    throw InputError(path + ": image has no pixels");
+  checkSize(path, raw.width, raw.height);
+  if (raw.channels <= 0) throw InputError(path + ": image has no channels");
   const size_t count = size_t(raw.width) * size_t(raw.height) * size_t(raw.channels);
   int w = 0, h = 0, n = 0;
   if (stbi_is_hdr_from_memory(data, size)) {
@@ -144,9 +153,8 @@ RawPixels readPfm(const std::string& path, const std::vector<unsigned char>& byt
   double scale = 0.0;
   if (!(in >> magic >> width >> height >> scale) || !std::isspace(in.get()))
     throw InputError(path + ": PFM header is malformed");
-  if (width <= 0 || height <= 0 || width > (1 << 20) || height > (1 << 20) || !std::isfinite(scale) ||
-      scale == 0.0)
-    throw InputError(path + ": PFM header gives an invalid size or scale");
+  checkSize(path, width, height);
+  if (!std::isfinite(scale) || scale == 0.0) throw InputError(path + ": PFM header gives an invalid scale");
   const int channels = magic == "PF" ? 3 : 1;
   const size_t count = size_t(width) * size_t(height) * size_t(channels);
   const size_t offset = size_t(in.tellg());

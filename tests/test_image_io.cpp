@@ -205,6 +205,24 @@ TEST(ImageIo, PfmBothByteOrdersRowsFromTheBottom) {
   EXPECT_THROW(readTexture(dir.write("huge.pfm", "PF\n-3 2\n-1\n"), ColorEncoding::Auto), InputError);
 }
 
+TEST(ImageIo, HeadersClaimingHugeImagesAreRejectedBeforeAllocating) {
+  TempDir dir;
+  // A PNG signature and IHDR chunk of 20000 x 20000 grey, within stb_image's own limit of 2^30 bytes (it does
+  // not check the CRC).
+  std::string png = "\x89PNG\r\n\x1a\n";
+  png += std::string("\0\0\0\x0dIHDR", 8) + std::string("\0\0\x4e\x20\0\0\x4e\x20\x08\0\0\0\0", 13) + "CRC!";
+  const std::string big = dir.write("big.png", png);
+  const std::string pfmBig = dir.write("big.pfm", "PF\n100000 100000\n-1\n");
+  for (const std::string& path : {big, pfmBig}) {
+    try {
+      readTexture(path, ColorEncoding::Auto);
+      ADD_FAILURE() << path << " was read";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("larger than Ember reads"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(ImageIo, CorruptAndTruncatedImagesNameTheFile) {
   TempDir dir;
   // An EXR's magic number followed by garbage, and a PNG cut in half.
