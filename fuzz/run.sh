@@ -29,8 +29,8 @@ ASAN_OPTIONS=detect_leaks=0 build-fuzz/app/ember render scenes/cornell-area.json
 # Images: the reference EXRs (written by Mitsuba), Ember's own EXR and PNG outputs, the checker
 # texture, a 16-bit PNG, the glTF showcases' half-float EXR environment maps, and a PFM.
 cp tests/data/images/*.png scenes/*.png "$corpus/image/"
-find tests/data -name '*.exr' -size -1M | while read -r f; do cp "$f" "$corpus/image/$(echo "$f" | md5sum | cut -c1-16).exr"; done
-find scenes -name '*.exr' -size -1M | while read -r f; do cp "$f" "$corpus/image/$(echo "$f" | md5sum | cut -c1-16).exr"; done
+find tests/data -name '*.exr' -size -1024k | while read -r f; do cp "$f" "$corpus/image/$(echo "$f" | md5sum | cut -c1-16).exr"; done
+find scenes -name '*.exr' -size -1024k | while read -r f; do cp "$f" "$corpus/image/$(echo "$f" | md5sum | cut -c1-16).exr"; done
 mv "$corpus/seed.exr" "$corpus/image/ember.exr"
 printf 'PF\n1 1\n-1.0\n\0\0\200?\0\0\0@\0\0@@' > "$corpus/image/tiny.pfm"
 

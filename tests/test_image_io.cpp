@@ -223,6 +223,31 @@ TEST(ImageIo, HeadersClaimingHugeImagesAreRejectedBeforeAllocating) {
   }
 }
 
+TEST(ImageIo, ExrAttributeLargerThanTheFileIsRejected) {
+  TempDir dir;
+  const std::string path = dir.file("a.exr");
+  writeExr(path, Image(2, 2), {{"ember:note", "abc"}});
+  std::string bytes;
+  {
+    std::ifstream in(path, std::ios::binary);
+    bytes.assign((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  }
+  const std::string key("ember:note\0string\0", 18);
+  const size_t at = bytes.find(key);
+  ASSERT_NE(at, std::string::npos);
+  const int32_t huge = 0x7fffffff;  // OpenEXR would allocate this before finding the file short
+  std::memcpy(&bytes[at + key.size()], &huge, 4);
+  const std::string bad = dir.write("bad.exr", bytes);
+  try {
+    readImageRgb(bad);
+    ADD_FAILURE() << "read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("'ember:note' declares 2147483647 bytes"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(readStringMetadata(bad), InputError);
+}
+
 TEST(ImageIo, CorruptAndTruncatedImagesNameTheFile) {
   TempDir dir;
   // An EXR's magic number followed by garbage, and a PNG cut in half.
