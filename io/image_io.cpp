@@ -26,6 +26,7 @@
 #include <limits>
 #include <memory>
 #include <sstream>
+#include <type_traits>
 
 namespace ember {
 
@@ -174,20 +175,20 @@ RawPixels readStb(const std::string& path, const std::vector<unsigned char>& byt
         stbi_loadf_from_memory(data, size, &w, &h, &n, 0), &stbi_image_free);
     if (!px) throw fail();
     raw.data.assign(px.get(), px.get() + count);
-  } else if (stbi_is_16_bit_from_memory(data, size)) {
-    const std::unique_ptr<stbi_us, decltype(&stbi_image_free)> px(
-        stbi_load_16_from_memory(data, size, &w, &h, &n, 0), &stbi_image_free);
-    if (!px) throw fail();
-    raw.integer = true;
-    raw.data.resize(count);
-    for (size_t i = 0; i < count; ++i) raw.data[i] = float(px.get()[i]) / 65535.0f;
   } else {
-    const std::unique_ptr<stbi_uc, decltype(&stbi_image_free)> px(
-        stbi_load_from_memory(data, size, &w, &h, &n, 0), &stbi_image_free);
-    if (!px) throw fail();
-    raw.integer = true;
-    raw.data.resize(count);
-    for (size_t i = 0; i < count; ++i) raw.data[i] = float(px.get()[i]) / 255.0f;
+    // 8- or 16-bit integers, scaled so that the largest value reads as 1.
+    const auto scaled = [&](auto* pixels, float maxValue) {
+      const std::unique_ptr<std::remove_pointer_t<decltype(pixels)>, decltype(&stbi_image_free)> px(
+          pixels, &stbi_image_free);
+      if (!px) throw fail();
+      raw.integer = true;
+      raw.data.resize(count);
+      for (size_t i = 0; i < count; ++i) raw.data[i] = float(px.get()[i]) / maxValue;
+    };
+    if (stbi_is_16_bit_from_memory(data, size))
+      scaled(stbi_load_16_from_memory(data, size, &w, &h, &n, 0), 65535.0f);
+    else
+      scaled(stbi_load_from_memory(data, size, &w, &h, &n, 0), 255.0f);
   }
   if (w != raw.width || h != raw.height || n != raw.channels)
     throw InputError(path + ": image changed size while decoding");
