@@ -3,7 +3,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup-deps.sh
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DEMBER_PGO=ON >/dev/null
 cmake --build build -j "$(nproc)" --target ember
 mkdir -p out
 ./build/app/ember render "${1:-scenes/demo.json}" -o out/demo.exr --png out/demo.png

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The whole test suite, from a fresh machine: Debian packages, a Release build and every test
+# The whole test suite, from a fresh machine: Debian packages, a Release build (profile-guided, as
+# scripts/demo.sh builds it: cmake/Pgo.cmake) and every test
 # (unit, statistical, whole-image comparisons, MPI with 2 and 3 ranks), then an ASan+UBSan build
 # running the unit tests, then a short run of each libFuzzer target (fuzz/run.sh).
 set -euo pipefail
@@ -7,7 +8,7 @@ cd "$(dirname "$0")/.."
 scripts/setup-deps.sh
 jobs=$(nproc)
 
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DEMBER_PGO=ON >/dev/null
 cmake --build build -j "$jobs"
 ctest --test-dir build --output-on-failure -j "$jobs"
 
