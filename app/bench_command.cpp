@@ -78,8 +78,11 @@ int runBench(const BenchArgs& a) {
 
   nlohmann::json report;
   report["ember_version"] = EMBER_VERSION;
-  report["build"] = {
-      {"type", EMBER_BUILD_TYPE}, {"cxx_flags", EMBER_CXX_FLAGS}, {"compiler", EMBER_COMPILER}};
+  report["build"] = {{"type", EMBER_BUILD_TYPE},
+                     {"cxx_flags", EMBER_CXX_FLAGS},
+                     {"compiler", EMBER_COMPILER},
+                     {"lto", bool(EMBER_LTO_BUILD)},
+                     {"pgo", bool(EMBER_PGO_BUILD)}};
   report["machine"] = {{"cpu", cpuModel()}, {"cores", tbb::info::default_concurrency()}};
   report["threads"] = a.threads > 0 ? a.threads : tbb::info::default_concurrency();
   report["repeat"] = a.repeat;
@@ -149,9 +152,9 @@ int runBench(const BenchArgs& a) {
         static_cast<unsigned long long>(med.nonFinite), peakResidentMb(), anonymousMb);
     std::fflush(stdout);
   }
-  std::printf("machine: %s, %d cores, Embree ISA %s; ember %s (%s)\n", cpuModel().c_str(),
+  std::printf("machine: %s, %d cores, Embree ISA %s; ember %s (%s%s%s)\n", cpuModel().c_str(),
               tbb::info::default_concurrency(), report["machine"].value("isa", "?").c_str(), EMBER_VERSION,
-              EMBER_BUILD_TYPE);
+              EMBER_BUILD_TYPE, EMBER_LTO_BUILD ? ", LTO" : "", EMBER_PGO_BUILD ? ", PGO" : "");
   if (!a.json.empty()) {
     // Temporary file, then rename, like every other output of ember.
     const std::string tmp = a.json + ".tmp";

@@ -1,0 +1,54 @@
+// `ember bench` as a user runs it: the JSON report's layout (docs/performance.md, "ember bench
+// --json"), which tells builds apart, and bad input.
+#include "tests/cli_runner.h"
+#include "tests/test_paths.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+
+namespace ember {
+namespace {
+
+TEST(BenchCommand, JsonReportsTheBuildAndTheRates) {
+  test::TempDir dir;
+  const std::string out = dir.file("bench.json");
+  const test::CliResult r = test::runEmber("bench '" + test::sourcePath("scenes/cornell-point.json") +
+                                           "' --spp 1 --repeat 2 --threads 1 --json '" + out + "'");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  std::ifstream in(out);
+  const nlohmann::json report = nlohmann::json::parse(in);
+
+  const nlohmann::json& build = report.at("build");
+  EXPECT_TRUE(build.at("type").is_string());
+  EXPECT_TRUE(build.at("compiler").is_string());
+  EXPECT_TRUE(build.at("lto").is_boolean());
+  EXPECT_TRUE(build.at("pgo").is_boolean());
+  EXPECT_EQ(report.at("threads"), 1);
+  EXPECT_EQ(report.at("repeat"), 2);
+
+  ASSERT_EQ(report.at("scenes").size(), 1u);
+  const nlohmann::json& scene = report.at("scenes")[0];
+  EXPECT_EQ(scene.at("spp"), 1);
+  EXPECT_EQ(scene.at("width"), 256);
+  EXPECT_EQ(scene.at("render_seconds_all").size(), 2u);
+  for (const char* rate : {"samples_per_second", "path_vertices_per_second", "closest_hit_rays_per_second",
+                           "shadow_rays_per_second", "rays_per_second"})
+    EXPECT_GT(scene.at(rate).get<double>(), 0.0) << rate;
+  EXPECT_EQ(scene.at("nonfinite_samples"), 0);
+}
+
+TEST(BenchCommand, MissingSceneNamesItAndWritesNoReport) {
+  test::TempDir dir;
+  const std::string out = dir.file("bench.json");
+  const test::CliResult r =
+      test::runEmber("bench '" + dir.file("absent.json") + "' --spp 1 --json '" + out + "'");
+  EXPECT_NE(r.exitCode, 0);
+  EXPECT_NE(r.output.find("absent.json"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+}  // namespace
+}  // namespace ember
