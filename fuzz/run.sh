@@ -22,8 +22,11 @@ seed_dirs=()
 for d in scenes/gltf /usr/share/assimp/models/glTF2 ../shared/assets/gltf; do
   if [ -d "$d" ]; then seed_dirs+=("$d"); fi
 done
+# Under 1 MiB each, as the image seeds below: a larger seed slows every execution. (find rounds a
+# size up to its unit before comparing: -size -1024k keeps files of at most 1023 KiB, and the
+# -size -2M this replaces kept at most 1 MiB, not the 2 MiB it seemed to say.)
 find "${seed_dirs[@]}" \( -name '*.gltf' -o -name '*.glb' \) \
-  -size -2M 2>/dev/null | while read -r f; do cp "$f" "$corpus/gltf/$(echo "$f" | md5sum | cut -c1-16)$(basename "$f" | sed 's/.*\(\.gl[tb]f*\)$/\1/')"; done
+  -size -1024k 2>/dev/null | while read -r f; do cp "$f" "$corpus/gltf/$(echo "$f" | md5sum | cut -c1-16)$(basename "$f" | sed 's/.*\(\.gl[tb]f*\)$/\1/')"; done
 ASAN_OPTIONS=detect_leaks=0 build-fuzz/app/ember render scenes/cornell-area.json -o "$corpus/seed.exr" --width 8 \
   --height 6 --spp 2 -q --checkpoint "$corpus/checkpoint/seed.ckpt" 2>/dev/null
 # Images: the reference EXRs (written by Mitsuba), Ember's own EXR and PNG outputs, the checker
