@@ -5,7 +5,7 @@
 # the gain on scenes the profile never saw), and compiles everything with the profile it wrote.
 # The compiler then lays out the hot path by the branches it took and inlines by the calls it
 # made; floating-point semantics are unchanged, so images stay bit-identical (docs/performance.md,
-# optimisation log: 0.90-0.92x the render time).
+# optimisation log: 0.90-0.98x the render time).
 #
 # Functions the training never ran are optimised as without a profile (-fprofile-partial-training),
 # so a scene unlike the training set is not slowed by it. The profile is remade whenever the

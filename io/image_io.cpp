@@ -69,18 +69,22 @@ void limitOpenExr() {
 // OpenEXR allocates each header attribute at the size the file declares for it: a mutated size of
 // a gigabyte costs a gigabyte before the read fails. So the attributes are walked here first (name,
 // type name, 32-bit size, value; an empty name ends a header, and an empty header ends the headers
-// of a multi-part file), and a size that runs past the end of the file is rejected.
+// of a multi-part file), and a size that runs past the end of the file is rejected. Only the
+// headers are read: each value is skipped by seeking, so the pixels are read once, by OpenEXR.
 void checkExrAttributeSizes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (bytes.size() < 8) throw InputError(path + ": EXR file ends inside its header");
-  const bool multiPart = (uint8_t(bytes[5]) & 0x10) != 0;  // version field bit 12
-  size_t pos = 8;
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  const auto fileSize = uint64_t(std::max<std::streamoff>(0, in.tellg()));
+  const auto truncated = [&] { return InputError(path + ": EXR file ends inside its header"); };
+  char version[8];
+  if (!in.seekg(0) || !in.read(version, sizeof version)) throw truncated();
+  const bool multiPart = (uint8_t(version[5]) & 0x10) != 0;  // version field bit 12
   const auto readString = [&]() {
-    const size_t start = pos;
-    while (pos < bytes.size() && bytes[pos] != 0) ++pos;
-    if (pos == bytes.size()) throw InputError(path + ": EXR file ends inside its header");
-    return std::string(&bytes[start], pos++ - start);
+    std::string text;
+    for (char c; in.get(c);) {
+      if (c == 0) return text;
+      text += c;
+    }
+    throw truncated();
   };
   for (bool firstOfHeader = true;;) {
     const std::string name = readString();
@@ -90,15 +94,14 @@ void checkExrAttributeSizes(const std::string& path) {
       continue;
     }
     firstOfHeader = false;
-    readString();  // the type name
-    int32_t size = 0;
-    if (bytes.size() - pos < sizeof size) throw InputError(path + ": EXR file ends inside its header");
-    std::memcpy(&size, &bytes[pos], sizeof size);  // little-endian, as x86 and ARM hosts are
-    pos += sizeof size;
-    if (size < 0 || size_t(size) > bytes.size() - pos)
+    readString();      // the type name
+    int32_t size = 0;  // little-endian, as x86 and ARM hosts are
+    if (!in.read(reinterpret_cast<char*>(&size), sizeof size)) throw truncated();
+    const uint64_t pos = uint64_t(in.tellg());
+    if (size < 0 || uint64_t(size) > fileSize - pos)
       throw InputError(path + ": EXR header attribute '" + name + "' declares " + std::to_string(size) +
                        " bytes, more than the file holds");
-    pos += size_t(size);
+    in.seekg(std::streamoff(size), std::ios::cur);
   }
 }
 
