@@ -18,6 +18,9 @@ EmbreeAccel::EmbreeAccel() {
   device_ = rtcNewDevice(nullptr);
   if (!device_) throw std::runtime_error("could not create an Embree device");
   rtcSetDeviceErrorFunction(device_, embreeErrorHandler, nullptr);
+  if (rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) == 0 &&
+      rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED) != 0)
+    packetWidth_ = 8;
   scene_ = rtcNewScene(device_);
   // Medium (Embree's default, a binned SAH build): on the million-triangle scaling scene it
   // builds in 0.45 s instead of high quality's 1.8 s (spatial splits), and renders as fast
@@ -146,6 +149,11 @@ Bounds EmbreeAccel::bounds() const {
   out.extend(Vec3(b.lower_x, b.lower_y, b.lower_z));
   out.extend(Vec3(b.upper_x, b.upper_y, b.upper_z));
   return out;
+}
+
+void EmbreeAccel::setPacketWidth(unsigned width) {
+  if (width != 8 && width != 16) throw std::invalid_argument("packets hold 8 or 16 rays");
+  packetWidth_ = width;
 }
 
 const char* EmbreeAccel::isaName() const {

@@ -61,11 +61,20 @@ class EmbreeAccel {
 
   Bounds bounds() const;
   const char* isaName() const;
+  // Rays per packet for batches (packet/ray_batch.h): 16 where Embree traverses 16-wide packets
+  // natively (AVX-512), else 8 where it does 8 (AVX2, AVX). Embree splits a packet wider than its
+  // own into packets of its width and calls the shapes' callbacks with those, after copying every
+  // ray twice (measured in docs/performance.md). Where neither is native (SSE), 16.
+  unsigned packetWidth() const { return packetWidth_; }
+  // Overrides the choice (8 or 16), so that tests can check that both widths give the same
+  // hits on any machine.
+  void setPacketWidth(unsigned width);
   RTCScene rtcScene() const { return scene_; }  // for the raw-throughput benchmark
 
  private:
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
+  unsigned packetWidth_ = 16;
   std::vector<std::unique_ptr<ShapeGeometry>> shapes_;  // the user geometries' data
 };
 

@@ -14,11 +14,13 @@ namespace hn = hwy::HWY_NAMESPACE;
 
 using D = hn::CappedTag<float, kPacketTfarLanes>;
 
-void WidenLiveTfar16(float* tfar, const int* valid, float* saved) {
+void WidenLiveTfar(float* tfar, const int* valid, float* saved, unsigned n) {
   const D d;
   const hn::RebindToSigned<D> di;
   const auto infinity = hn::Set(d, std::numeric_limits<float>::infinity());
-  for (unsigned i = 0; i < kPacketTfarLanes; i += unsigned(hn::Lanes(d))) {
+  const unsigned step = unsigned(hn::Lanes(d));
+  unsigned i = 0;
+  for (; i + step <= n; i += step) {
     const auto t = hn::LoadU(d, tfar + i);
     hn::StoreU(t, d, saved + i);
     const auto live = hn::RebindMask(d, hn::Ne(hn::LoadU(di, valid + i), hn::Zero(di)));
@@ -26,15 +28,23 @@ void WidenLiveTfar16(float* tfar, const int* valid, float* saved) {
     const auto up = hn::BitCast(d, hn::Add(hn::BitCast(di, t), hn::Set(di, 1)));
     hn::StoreU(hn::IfThenElse(hn::And(live, hn::Lt(t, infinity)), up, t), d, tfar + i);
   }
+  for (; i < n; ++i) {
+    saved[i] = tfar[i];
+    if (valid[i]) tfar[i] = nextFloatUp(tfar[i]);
+  }
 }
 
-void StoreLiveTfar16(float* tfar, const int* valid, const float* result) {
+void StoreLiveTfar(float* tfar, const int* valid, const float* result, unsigned n) {
   const D d;
   const hn::RebindToSigned<D> di;
-  for (unsigned i = 0; i < kPacketTfarLanes; i += unsigned(hn::Lanes(d))) {
+  const unsigned step = unsigned(hn::Lanes(d));
+  unsigned i = 0;
+  for (; i + step <= n; i += step) {
     const auto live = hn::RebindMask(d, hn::Ne(hn::LoadU(di, valid + i), hn::Zero(di)));
     hn::StoreU(hn::IfThenElse(live, hn::LoadU(d, result + i), hn::LoadU(d, tfar + i)), d, tfar + i);
   }
+  for (; i < n; ++i)
+    if (valid[i]) tfar[i] = result[i];
 }
 
 }  // namespace ember::HWY_NAMESPACE
@@ -43,15 +53,15 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 namespace ember {
 
-HWY_EXPORT(WidenLiveTfar16);
-HWY_EXPORT(StoreLiveTfar16);
+HWY_EXPORT(WidenLiveTfar);
+HWY_EXPORT(StoreLiveTfar);
 
-void widenLiveTfar16(float* tfar, const int* valid, float* saved) {
-  HWY_DYNAMIC_DISPATCH(WidenLiveTfar16)(tfar, valid, saved);
+void widenLiveTfar(float* tfar, const int* valid, float* saved, unsigned n) {
+  HWY_DYNAMIC_DISPATCH(WidenLiveTfar)(tfar, valid, saved, n);
 }
 
-void storeLiveTfar16(float* tfar, const int* valid, const float* result) {
-  HWY_DYNAMIC_DISPATCH(StoreLiveTfar16)(tfar, valid, result);
+void storeLiveTfar(float* tfar, const int* valid, const float* result, unsigned n) {
+  HWY_DYNAMIC_DISPATCH(StoreLiveTfar)(tfar, valid, result, n);
 }
 
 }  // namespace ember

@@ -80,6 +80,10 @@ HWY_INLINE uint32_t forEachBlock(D d, const RayLanes& rays, Block block) {
   return bits & inRange;
 }
 
+unsigned RayLanesStep() {
+  return unsigned(hn::Lanes(D()));
+}
+
 void TriangleLanesKernel(const RayLanes& rays, const TriangleFilter& tri, TriangleLanes& out) {
   const D d;
   const Vec3V n = splat(d, tri.n), v0 = splat(d, tri.v0), g1 = splat(d, tri.g1), g2 = splat(d, tri.g2);
@@ -298,6 +302,7 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 namespace ember {
 
+HWY_EXPORT(RayLanesStep);
 HWY_EXPORT(TriangleLanesKernel);
 HWY_EXPORT(SphereCandidates);
 HWY_EXPORT(SphereHitsKernel);
@@ -326,6 +331,11 @@ TriangleFilter TriangleFilter::of(const Vec3& v0, const Vec3& v1, const Vec3& v2
   f.g1Sum = 1.01f * (std::abs(f.g1.x) + std::abs(f.g1.y) + std::abs(f.g1.z));
   f.g2Sum = 1.01f * (std::abs(f.g2.x) + std::abs(f.g2.y) + std::abs(f.g2.z));
   return f;
+}
+
+unsigned rayLanesStep() {
+  static const unsigned step = HWY_DYNAMIC_DISPATCH(RayLanesStep)();
+  return step;
 }
 
 void triangleLanes(const RayLanes& rays, const TriangleFilter& tri, TriangleLanes& out) {

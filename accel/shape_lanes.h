@@ -74,6 +74,12 @@ struct TriangleLanes {
   uint32_t inside = 0;
 };
 
+// The lane kernels read RayLanes' arrays in blocks of this many floats (the widest SIMD vector of
+// the CPU's Highway target, at most kMaxLanes); the double-precision kernels in blocks of half
+// as many doubles. So a RayLanes whose n is a multiple of it may point into arrays of exactly n
+// floats; any other n needs arrays of kMaxLanes.
+unsigned rayLanesStep();
+
 void triangleLanes(const RayLanes& rays, const TriangleFilter& tri, TriangleLanes& out);
 
 // Bit i set: live lane i may hit the sphere (its discriminant may be >= 0).

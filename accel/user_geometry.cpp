@@ -24,11 +24,12 @@ void shapeBoundsCallback(const RTCBoundsFunctionArguments* args) {
 }
 
 // A ray packet in Embree's RTCRayN layout (each field an array of N floats, in RTCRay's order),
-// in blocks of RayLanes::kMaxLanes lanes for the shapes' lane filters. Packets of other widths
-// (Embree only sends 16 or 1 here, as Ember casts rtcIntersect16 and rtcIntersect1) are copied
-// into a padded block, so a filter never reads past an array. The padded block is the thread's
-// own, zeroed once: a block copies only its live rays' fields (a single ray copies one lane), and
-// the lanes past them keep earlier rays' finite values, never live.
+// in blocks of up to RayLanes::kMaxLanes lanes for the shapes' lane filters. A block the filters
+// can read in place (16 lanes, or a width their vectors divide: 8-ray packets on AVX2) points into
+// Embree's arrays; any other (a single ray, or 8 rays for 16-float vectors) is copied into a
+// padded block, so a filter never reads past an array. The padded block is the thread's own,
+// zeroed once: a block copies only its live rays' fields, and the lanes past them keep earlier
+// rays' finite values, never live.
 class PacketLanes {
  public:
   PacketLanes(RTCRayN* rays, unsigned n, const int* valid, bool needsUv)
@@ -38,7 +39,7 @@ class PacketLanes {
   RayLanes block(unsigned k) {
     const unsigned first = k * RayLanes::kMaxLanes;
     const unsigned count = std::min(RayLanes::kMaxLanes, n_ - first);
-    if (n_ % RayLanes::kMaxLanes == 0) {
+    if (count == RayLanes::kMaxLanes || count % rayLanesStep() == 0) {
       auto field = [&](unsigned i) { return f_ + i * n_ + first; };
       return RayLanes{{field(0), field(1), field(2)},
                       {field(4), field(5), field(6)},
@@ -102,7 +103,7 @@ void intersectPacket(const Shape& shape, bool needsUv, RTCRayN* rays, unsigned n
   }
 }
 
-static_assert(kPacketTfarLanes <= RayLanes::kMaxLanes);
+static_assert(kPacketTfarLanes == RayLanes::kMaxLanes);
 
 void shapeIntersectCallback(const RTCIntersectFunctionNArguments* args) {
   const auto* geometry = static_cast<const ShapeGeometry*>(args->geometryUserPtr);
@@ -113,17 +114,9 @@ void shapeIntersectCallback(const RTCIntersectFunctionNArguments* args) {
   // t rounds onto the current tfar would be kept by the shape Embree happens to visit first, and
   // Embree visits them in another order for single rays than for packets. So the shapes see tfar
   // one float step further, and every hit that rounds onto tfar reaches the rule below.
-  float tfar[RayLanes::kMaxLanes];  // Embree calls with packets of 16 or single rays (PacketLanes)
+  float tfar[kPacketTfarLanes];
   float* rayTfar = &RTCRayN_tfar(rays, n, 0);
-  const bool packet16 = n == kPacketTfarLanes;
-  if (packet16) {
-    widenLiveTfar16(rayTfar, args->valid, tfar);
-  } else {
-    for (unsigned i = 0; i < n; ++i) {
-      tfar[i] = rayTfar[i];
-      if (args->valid[i]) rayTfar[i] = nextFloatUp(tfar[i]);
-    }
-  }
+  widenLiveTfar(rayTfar, args->valid, tfar, n);
   intersectPacket(*geometry->shape, geometry->needsUv, rays, n, args->valid,
                   [&](unsigned i, const LocalHit& h) {
                     if (!(h.t <= tfar[i])) return;
@@ -144,12 +137,7 @@ void shapeIntersectCallback(const RTCIntersectFunctionNArguments* args) {
                     RTCHitN_geomID(hits, n, i) = args->geomID;
                     RTCHitN_instID(hits, n, i, 0) = args->context->instID[0];
                   });
-  if (packet16) {
-    storeLiveTfar16(rayTfar, args->valid, tfar);
-  } else {
-    for (unsigned i = 0; i < n; ++i)
-      if (args->valid[i]) rayTfar[i] = tfar[i];
-  }
+  storeLiveTfar(rayTfar, args->valid, tfar, n);
 }
 
 void shapeOccludedCallback(const RTCOccludedFunctionNArguments* args) {

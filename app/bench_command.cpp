@@ -104,6 +104,7 @@ int runBench(const BenchArgs& a) {
     if (const std::string w = unreachableLightsWarning(scene, scene.settings.strategy); !w.empty())
       std::fprintf(stderr, "ember: warning: %s: %s\n", path.c_str(), w.c_str());
     report["machine"]["isa"] = scene.accel().isaName();
+    report["machine"]["packet_width"] = scene.accel().packetWidth();
 
     const std::unique_ptr<Integrator> integrator = makeIntegrator(scene.settings, *parseKernel(a.kernel));
     RenderOptions options;

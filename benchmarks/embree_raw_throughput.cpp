@@ -97,6 +97,7 @@ int run(int argc, char** argv) {
   RTCScene rtc = scene.accel().rtcScene();
   const int all = tbb::info::default_concurrency();
 
+  std::printf("batches: packets of %u rays (Embree's native width here)\n", scene.accel().packetWidth());
   std::printf("%-34s %10s %10s\n", "ray kind (Mrays/s)", "1 thread",
               std::to_string(all).append(" threads").c_str());
   auto row = [&](const char* name, auto work) {
@@ -153,8 +154,8 @@ int run(int argc, char** argv) {
   // traced as 16 packets or as one stream, hits read back.
   auto batchRow = [&](const char* name, BatchTraversal traversal, bool shadow) {
     row(name, [&, traversal, shadow](size_t lo, size_t hi) {
-      ClosestHitBatch closest(256);
-      ShadowBatch shadows(256);
+      ClosestHitBatch closest(256, scene.accel().packetWidth());
+      ShadowBatch shadows(256, scene.accel().packetWidth());
       RawHit raw;
       for (size_t i = lo; i < hi; i += 256) {
         const size_t end = std::min(hi, i + 256);
@@ -171,9 +172,9 @@ int run(int argc, char** argv) {
       }
     });
   };
-  batchRow("closest-hit, batch of 16-packets", BatchTraversal::Packets, false);
+  batchRow("closest-hit, batch of packets", BatchTraversal::Packets, false);
   batchRow("closest-hit, batch as a stream", BatchTraversal::Stream, false);
-  batchRow("shadow, batch of 16-packets", BatchTraversal::Packets, true);
+  batchRow("shadow, batch of packets", BatchTraversal::Packets, true);
   batchRow("shadow, batch as a stream", BatchTraversal::Stream, true);
   // The mix a path tracer casts: one closest-hit and one shadow ray per path vertex.
   row("vertex mix (1 closest + 1 shadow)", [&](size_t lo, size_t hi) {
@@ -183,9 +184,9 @@ int run(int argc, char** argv) {
       scene.occluded(b.shadow[i]);
     }
   });
-  row("vertex mix, batches of 16-packets", [&](size_t lo, size_t hi) {
-    ClosestHitBatch closest(256);
-    ShadowBatch shadows(256);
+  row("vertex mix, batches of packets", [&](size_t lo, size_t hi) {
+    ClosestHitBatch closest(256, scene.accel().packetWidth());
+    ShadowBatch shadows(256, scene.accel().packetWidth());
     RawHit raw;
     for (size_t i = lo; i < hi; i += 256) {
       const size_t end = std::min(hi, i + 256);

@@ -74,9 +74,10 @@ void traceCausticsInWaves(const Scene& scene, int maxDepth, int rrDepth, uint64_
         _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
         _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
         LightWave& wave = threadLightWave();
+        wave.closest.setWidth(scene.accel().packetWidth());
+        wave.shadows.setWidth(scene.accel().packetWidth());
         PathStats local;
         size_t active = 0;
-        wave.closest.clear();
         // The emissions: every path's four requests drawn together, in start's order.
         const size_t lanes = size_t(range.size());
         for (size_t i = 0; i < lanes; ++i) {

@@ -1,77 +1,124 @@
 #include "packet/ray_batch.h"
 
 #include <algorithm>
+#include <bit>
+#include <cstdlib>
+#include <new>
 #include <stdexcept>
 
 namespace ember {
 
 namespace {
 
-constexpr size_t kLanes = 16;
-
-size_t packetsFor(size_t capacity) {
-  return (capacity + kLanes - 1) / kLanes;
-}
+constexpr size_t kMaxWidth = 16;
+constexpr size_t kFloatsPerRay = sizeof(RTCRay16) / (16 * sizeof(float));
+constexpr size_t kFloatsPerRayHit = sizeof(RTCRayHit16) / (16 * sizeof(float));
+static_assert(sizeof(RTCRay8) == 8 * kFloatsPerRay * sizeof(float));
+static_assert(sizeof(RTCRayHit8) == 8 * kFloatsPerRayHit * sizeof(float));
 
 // An untraceable ray (accel/embree_accel.h) becomes an inactive lane at the origin with the
 // empty interval (1, 0): it misses, and as a shadow ray it is unblocked, as EmbreeAccel treats
 // single rays.
-template <typename Packet>
-void writeRay(Packet& p, size_t lane, const Ray& given) {
+void writeRay(RTCRayN* p, unsigned n, unsigned lane, const Ray& given) {
   static const Ray inactive{Vec3(0.0f), Vec3(0.0f, 0.0f, 1.0f), 0.0f};
   const bool ok = traceable(given);
   const Ray& ray = ok ? given : inactive;
-  p.org_x[lane] = ray.origin.x;
-  p.org_y[lane] = ray.origin.y;
-  p.org_z[lane] = ray.origin.z;
-  p.tnear[lane] = ok ? 0.0f : 1.0f;
-  p.dir_x[lane] = ray.dir.x;
-  p.dir_y[lane] = ray.dir.y;
-  p.dir_z[lane] = ray.dir.z;
-  p.tfar[lane] = ray.tMax;
+  RTCRayN_org_x(p, n, lane) = ray.origin.x;
+  RTCRayN_org_y(p, n, lane) = ray.origin.y;
+  RTCRayN_org_z(p, n, lane) = ray.origin.z;
+  RTCRayN_tnear(p, n, lane) = ok ? 0.0f : 1.0f;
+  RTCRayN_dir_x(p, n, lane) = ray.dir.x;
+  RTCRayN_dir_y(p, n, lane) = ray.dir.y;
+  RTCRayN_dir_z(p, n, lane) = ray.dir.z;
+  RTCRayN_tfar(p, n, lane) = ray.tMax;
 }
 
-// The fields no ray changes, written once per packet at construction.
-template <typename Packet>
-void initFixedFields(Packet& p) {
-  for (size_t lane = 0; lane < kLanes; ++lane) {
-    p.time[lane] = 0.0f;
-    p.mask[lane] = 0xFFFFFFFFu;  // Debian's Embree is built with ray masks: 0 would miss everything
-    p.id[lane] = unsigned(lane);
-    p.flags[lane] = 0;
+// The fields no ray changes, written once per packet when the layout is set.
+void initFixedFields(RTCRayN* p, unsigned n) {
+  for (unsigned lane = 0; lane < n; ++lane) {
+    RTCRayN_time(p, n, lane) = 0.0f;
+    RTCRayN_mask(p, n, lane) =
+        0xFFFFFFFFu;  // Debian's Embree is built with ray masks: 0 would miss everything
+    RTCRayN_id(p, n, lane) = lane;
+    RTCRayN_flags(p, n, lane) = 0;
   }
 }
 
 // Lanes [0, count) of a packet are valid. Packets after the last are never traced.
-void validMask(int (&valid)[kLanes], size_t count) {
-  for (size_t i = 0; i < kLanes; ++i) valid[i] = i < count ? -1 : 0;
+void validMask(int (&valid)[kMaxWidth], size_t count) {
+  for (size_t i = 0; i < kMaxWidth; ++i) valid[i] = i < count ? -1 : 0;
 }
 
-// Stream calls have no valid mask: the unused lanes of the last packet get an empty interval,
-// which Embree treats as an inactive ray.
-template <typename Packet>
-void disableLanes(Packet& p, size_t from) {
-  for (size_t i = from; i < kLanes; ++i) {
-    p.tnear[i] = 1.0f;
-    p.tfar[i] = 0.0f;
+// Stream calls have no valid mask, and where Embree splits a packet wider than its own it looks
+// past the mask too: so the unused lanes of the last packet always get the valid, empty interval
+// (1, 0) at the origin, which Embree treats as an inactive ray. (Left as they were, they held
+// whatever the storage held: an uninitialised lane tripped Embree's assertion that every active
+// ray is valid.)
+void disableLanes(RTCRayN* p, unsigned n, size_t from) {
+  for (size_t i = from; i < n; ++i) {
+    RTCRayN_org_x(p, n, unsigned(i)) = 0.0f;
+    RTCRayN_org_y(p, n, unsigned(i)) = 0.0f;
+    RTCRayN_org_z(p, n, unsigned(i)) = 0.0f;
+    RTCRayN_dir_x(p, n, unsigned(i)) = 0.0f;
+    RTCRayN_dir_y(p, n, unsigned(i)) = 0.0f;
+    RTCRayN_dir_z(p, n, unsigned(i)) = 1.0f;
+    RTCRayN_tnear(p, n, unsigned(i)) = 1.0f;
+    RTCRayN_tfar(p, n, unsigned(i)) = 0.0f;
   }
+}
+
+unsigned checkedWidth(unsigned width) {
+  if (width != 8 && width != 16) throw std::invalid_argument("ray batches hold packets of 8 or 16 rays");
+  return width;
 }
 
 }  // namespace
 
-ClosestHitBatch::ClosestHitBatch(size_t capacity)
-    : capacity_(capacity), packets_(new RTCRayHit16[packetsFor(capacity)]) {
-  for (size_t k = 0; k < packetsFor(capacity); ++k) initFixedFields(packets_[k].ray);
+namespace detail {
+
+void PacketStorage::Free::operator()(float* p) const {
+  std::free(p);
+}
+
+PacketStorage::PacketStorage(size_t capacity, size_t floatsPerRay)
+    : capacity_(capacity), floatsPerRay_(floatsPerRay) {
+  // Whole packets of the widest layout: every narrower one fits in them.
+  const size_t floats = (capacity + kMaxWidth - 1) / kMaxWidth * kMaxWidth * floatsPerRay;
+  const size_t bytes = (floats * sizeof(float) + 63) / 64 * 64;
+  data_.reset(static_cast<float*>(std::aligned_alloc(64, std::max<size_t>(bytes, 64))));
+  if (!data_) throw std::bad_alloc();
+  std::fill(data_.get(), data_.get() + bytes / sizeof(float), 0.0f);
+}
+
+void PacketStorage::setWidth(unsigned width) {
+  width_ = checkedWidth(width);
+  shift_ = unsigned(std::countr_zero(width));
+  stride_ = floatsPerRay_ * width;
+  for (size_t k = 0; k < packets(capacity_); ++k)
+    initFixedFields(reinterpret_cast<RTCRayN*>(packet(k)), width);
+}
+
+}  // namespace detail
+
+ClosestHitBatch::ClosestHitBatch(size_t capacity, unsigned width)
+    : capacity_(capacity), storage_(capacity, kFloatsPerRayHit) {
+  storage_.setWidth(width);
+}
+
+void ClosestHitBatch::setWidth(unsigned width) {
+  size_ = 0;
+  if (width != storage_.width()) storage_.setWidth(width);
 }
 
 void ClosestHitBatch::push(const Ray& ray) {
   if (size_ == capacity_) throw std::logic_error("ClosestHitBatch overflow");
-  RTCRayHit16& p = packets_[size_ / kLanes];
-  const size_t lane = size_ % kLanes;
-  writeRay(p.ray, lane, ray);
-  p.hit.geomID[lane] = RTC_INVALID_GEOMETRY_ID;
-  p.hit.primID[lane] = RTC_INVALID_GEOMETRY_ID;
-  p.hit.instID[0][lane] = RTC_INVALID_GEOMETRY_ID;
+  const unsigned n = storage_.width(), lane = storage_.laneOf(size_);
+  RTCRayHitN* p = packetOf(size_);
+  writeRay(RTCRayHitN_RayN(p, n), n, lane, ray);
+  RTCHitN* h = RTCRayHitN_HitN(p, n);
+  RTCHitN_geomID(h, n, lane) = RTC_INVALID_GEOMETRY_ID;
+  RTCHitN_primID(h, n, lane) = RTC_INVALID_GEOMETRY_ID;
+  RTCHitN_instID(h, n, lane, 0) = RTC_INVALID_GEOMETRY_ID;
   ++size_;
 }
 
@@ -79,41 +126,53 @@ void ClosestHitBatch::trace(const EmbreeAccel& accel, BatchTraversal traversal) 
   if (size_ == 0) return;
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  const size_t packets = packetsFor(size_);
+  const unsigned n = storage_.width();
+  const size_t packets = storage_.packets(size_);
+  auto* last = reinterpret_cast<RTCRayHitN*>(storage_.packet(packets - 1));
+  disableLanes(RTCRayHitN_RayN(last, n), n, size_ - (packets - 1) * n);
   if (traversal == BatchTraversal::Stream) {
-    disableLanes(packets_[packets - 1].ray, size_ - (packets - 1) * kLanes);
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
-    rtcIntersectNM(accel.rtcScene(), &context, reinterpret_cast<RTCRayHitN*>(packets_.get()), kLanes, packets,
-                   sizeof(RTCRayHit16));
+    rtcIntersectNM(accel.rtcScene(), &context, reinterpret_cast<RTCRayHitN*>(storage_.packet(0)), n, packets,
+                   n * kFloatsPerRayHit * sizeof(float));
     return;
   }
-  alignas(64) int valid[kLanes];
+  alignas(64) int valid[kMaxWidth];
   for (size_t k = 0; k < packets; ++k) {
-    validMask(valid, std::min(kLanes, size_ - k * kLanes));
-    rtcIntersect16(valid, accel.rtcScene(), &context, &packets_[k]);
+    validMask(valid, std::min<size_t>(n, size_ - k * n));
+    if (n == 16)
+      rtcIntersect16(valid, accel.rtcScene(), &context, reinterpret_cast<RTCRayHit16*>(storage_.packet(k)));
+    else
+      rtcIntersect8(valid, accel.rtcScene(), &context, reinterpret_cast<RTCRayHit8*>(storage_.packet(k)));
   }
 }
 
 bool ClosestHitBatch::hit(size_t i, RawHit& out) const {
-  const RTCRayHit16& p = packets_[i / kLanes];
-  const size_t lane = i % kLanes;
-  if (p.hit.geomID[lane] == RTC_INVALID_GEOMETRY_ID) return false;
-  out.t = p.ray.tfar[lane];
-  out.geomID = p.hit.geomID[lane];
-  out.primID = p.hit.primID[lane];
-  out.ng = Vec3(p.hit.Ng_x[lane], p.hit.Ng_y[lane], p.hit.Ng_z[lane]);
-  out.uv = Vec2(p.hit.u[lane], p.hit.v[lane]);
+  const unsigned n = storage_.width(), lane = storage_.laneOf(i);
+  RTCRayHitN* p = packetOf(i);
+  RTCHitN* h = RTCRayHitN_HitN(p, n);
+  if (RTCHitN_geomID(h, n, lane) == RTC_INVALID_GEOMETRY_ID) return false;
+  out.t = RTCRayN_tfar(RTCRayHitN_RayN(p, n), n, lane);
+  out.geomID = RTCHitN_geomID(h, n, lane);
+  out.primID = RTCHitN_primID(h, n, lane);
+  out.ng = Vec3(RTCHitN_Ng_x(h, n, lane), RTCHitN_Ng_y(h, n, lane), RTCHitN_Ng_z(h, n, lane));
+  out.uv = Vec2(RTCHitN_u(h, n, lane), RTCHitN_v(h, n, lane));
   return true;
 }
 
-ShadowBatch::ShadowBatch(size_t capacity)
-    : capacity_(capacity), packets_(new RTCRay16[packetsFor(capacity)]) {
-  for (size_t k = 0; k < packetsFor(capacity); ++k) initFixedFields(packets_[k]);
+ShadowBatch::ShadowBatch(size_t capacity, unsigned width)
+    : capacity_(capacity), storage_(capacity, kFloatsPerRay) {
+  storage_.setWidth(width);
+}
+
+void ShadowBatch::setWidth(unsigned width) {
+  size_ = 0;
+  if (width != storage_.width()) storage_.setWidth(width);
 }
 
 void ShadowBatch::push(const Ray& ray) {
   if (size_ == capacity_) throw std::logic_error("ShadowBatch overflow");
-  writeRay(packets_[size_ / kLanes], size_ % kLanes, ray);
+  writeRay(reinterpret_cast<RTCRayN*>(storage_.packetOf(size_)), storage_.width(), storage_.laneOf(size_),
+           ray);
   ++size_;
 }
 
@@ -121,18 +180,22 @@ void ShadowBatch::trace(const EmbreeAccel& accel, BatchTraversal traversal) {
   if (size_ == 0) return;
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  const size_t packets = packetsFor(size_);
+  const unsigned n = storage_.width();
+  const size_t packets = storage_.packets(size_);
+  disableLanes(reinterpret_cast<RTCRayN*>(storage_.packet(packets - 1)), n, size_ - (packets - 1) * n);
   if (traversal == BatchTraversal::Stream) {
-    disableLanes(packets_[packets - 1], size_ - (packets - 1) * kLanes);
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
-    rtcOccludedNM(accel.rtcScene(), &context, reinterpret_cast<RTCRayN*>(packets_.get()), kLanes, packets,
-                  sizeof(RTCRay16));
+    rtcOccludedNM(accel.rtcScene(), &context, reinterpret_cast<RTCRayN*>(storage_.packet(0)), n, packets,
+                  n * kFloatsPerRay * sizeof(float));
     return;
   }
-  alignas(64) int valid[kLanes];
+  alignas(64) int valid[kMaxWidth];
   for (size_t k = 0; k < packets; ++k) {
-    validMask(valid, std::min(kLanes, size_ - k * kLanes));
-    rtcOccluded16(valid, accel.rtcScene(), &context, &packets_[k]);
+    validMask(valid, std::min<size_t>(n, size_ - k * n));
+    if (n == 16)
+      rtcOccluded16(valid, accel.rtcScene(), &context, reinterpret_cast<RTCRay16*>(storage_.packet(k)));
+    else
+      rtcOccluded8(valid, accel.rtcScene(), &context, reinterpret_cast<RTCRay8*>(storage_.packet(k)));
   }
 }
 

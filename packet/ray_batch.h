@@ -1,8 +1,11 @@
-// Rays cast together: up to `capacity` rays stored as Embree 16-wide packets (structure of arrays,
-// lane i of packet i / 16), traced by one call per packet (rtcIntersect16 / rtcOccluded16) or by
-// one stream call over all packets (rtcIntersectNM / rtcOccludedNM). Embree then tests each BVH
-// node against 16 rays at once, and our user-geometry callbacks get up to 16 rays per call
-// (accel/user_geometry.cpp), which they intersect together (accel/shape_lanes.h).
+// Rays cast together: up to `capacity` rays stored as Embree packets of `width` rays (8 or 16:
+// structure of arrays, lane i % width of packet i / width), traced by one call per packet
+// (rtcIntersect8/16, rtcOccluded8/16) or by one stream call over all packets (rtcIntersectNM /
+// rtcOccludedNM). Embree then tests each BVH node against a whole packet, and our user-geometry
+// callbacks get the packet's rays in one call (accel/user_geometry.cpp), which they intersect
+// together (accel/shape_lanes.h). The width should be the one Embree traverses natively
+// (EmbreeAccel::packetWidth): a packet of any other width Embree splits and copies into its own,
+// and calls the callbacks with those.
 // Storage is allocated once, at construction; push, trace and the queries allocate nothing.
 #pragma once
 
@@ -11,6 +14,7 @@
 #include <embree3/rtcore.h>
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 
 namespace ember {
@@ -18,10 +22,43 @@ namespace ember {
 // How a batch is handed to Embree; measured in docs/performance.md.
 enum class BatchTraversal { Packets, Stream };
 
+namespace detail {
+
+// Packets of 8 or 16 rays in one aligned allocation; `floatsPerRay` is the size of one ray's
+// record (RTCRayHitN or RTCRayN) in floats.
+class PacketStorage {
+ public:
+  PacketStorage(size_t capacity, size_t floatsPerRay);
+  // Lays the storage out as packets of `width` rays (8 or 16) with their fixed fields set.
+  void setWidth(unsigned width);
+  unsigned width() const { return width_; }
+  size_t packets(size_t rays) const { return (rays + width_ - 1) >> shift_; }
+  float* packet(size_t k) const { return data_.get() + k * stride_; }
+  float* packetOf(size_t i) const { return packet(i >> shift_); }
+  unsigned laneOf(size_t i) const { return unsigned(i & (width_ - 1)); }
+
+ private:
+  struct Free {
+    void operator()(float* p) const;
+  };
+  size_t capacity_;
+  size_t floatsPerRay_;
+  std::unique_ptr<float[], Free> data_;
+  unsigned width_ = 0;
+  unsigned shift_ = 0;
+  size_t stride_ = 0;  // floats per packet
+};
+
+}  // namespace detail
+
 class ClosestHitBatch {
  public:
-  explicit ClosestHitBatch(size_t capacity);
+  static constexpr unsigned kDefaultWidth = 16;
+  explicit ClosestHitBatch(size_t capacity, unsigned width = kDefaultWidth);
 
+  // Rays per packet, 8 or 16; changing it empties the batch.
+  void setWidth(unsigned width);
+  unsigned width() const { return storage_.width(); }
   void clear() { size_ = 0; }
   size_t size() const { return size_; }
   size_t capacity() const { return capacity_; }
@@ -31,29 +68,41 @@ class ClosestHitBatch {
   // The closest hit of ray i, as EmbreeAccel::intersect reports it; false if it hit nothing.
   bool hit(size_t i, RawHit& out) const;
   // The geomID ray i hit, RTC_INVALID_GEOMETRY_ID for a miss.
-  uint32_t geometryOf(size_t i) const { return packets_[i / 16].hit.geomID[i % 16]; }
+  uint32_t geometryOf(size_t i) const {
+    return RTCHitN_geomID(hitsOf(i), storage_.width(), storage_.laneOf(i));
+  }
 
  private:
+  RTCRayHitN* packetOf(size_t i) const { return reinterpret_cast<RTCRayHitN*>(storage_.packetOf(i)); }
+  RTCHitN* hitsOf(size_t i) const { return RTCRayHitN_HitN(packetOf(i), storage_.width()); }
+
   size_t capacity_;
   size_t size_ = 0;
-  std::unique_ptr<RTCRayHit16[]> packets_;
+  detail::PacketStorage storage_;
 };
 
 class ShadowBatch {
  public:
-  explicit ShadowBatch(size_t capacity);
+  static constexpr unsigned kDefaultWidth = 16;
+  explicit ShadowBatch(size_t capacity, unsigned width = kDefaultWidth);
 
+  // Rays per packet, 8 or 16; changing it empties the batch.
+  void setWidth(unsigned width);
+  unsigned width() const { return storage_.width(); }
   void clear() { size_ = 0; }
   size_t size() const { return size_; }
   // Appends a ray blocked by anything on its open segment (0, ray.tMax).
   void push(const Ray& ray);
   void trace(const EmbreeAccel& accel, BatchTraversal traversal = BatchTraversal::Packets);
-  bool occluded(size_t i) const { return packets_[i / 16].tfar[i % 16] < 0.0f; }
+  bool occluded(size_t i) const {
+    return RTCRayN_tfar(reinterpret_cast<RTCRayN*>(storage_.packetOf(i)), storage_.width(),
+                        storage_.laneOf(i)) < 0.0f;
+  }
 
  private:
   size_t capacity_;
   size_t size_ = 0;
-  std::unique_ptr<RTCRay16[]> packets_;
+  detail::PacketStorage storage_;
 };
 
 }  // namespace ember

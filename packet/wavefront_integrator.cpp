@@ -94,6 +94,8 @@ void WavefrontIntegrator::traceCaustics(const Scene& scene, uint64_t seed, Sampl
 void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, Film& film,
                                      PathStats& stats) const {
   Wave& wave = threadWave();
+  wave.closest.setWidth(scene.accel().packetWidth());
+  wave.shadows.setWidth(scene.accel().packetWidth());
   const int tileWidth = work.x1 - work.x0;
   const uint64_t pixels = uint64_t(tileWidth) * uint64_t(work.y1 - work.y0);
   const uint64_t total = pixels * uint64_t(work.spp);

@@ -60,7 +60,8 @@ namespace ember {
 
 // How `render` and `bench` run the path tracer (--kernel). All give the same image bit for bit;
 // they differ in speed (docs/performance.md).
-//  - wavefront: WavefrontIntegrator with one rtcIntersect16 / rtcOccluded16 call per packet;
+//  - wavefront: WavefrontIntegrator with one rtcIntersect16 / rtcOccluded16 call per packet (8
+//               where that is Embree's native width: EmbreeAccel::packetWidth);
 //  - stream:    WavefrontIntegrator handing each batch to Embree as one ray stream;
 //  - scalar:    PathIntegrator::Li, one ray at a time (the reference implementation).
 enum class Kernel { Wavefront, Stream, Scalar };

@@ -93,6 +93,8 @@ class Scene {
   const CausticTracer& causticTracer() const { return causticTracer_; }
   Bounds bounds() const { return bounds_; }
   const EmbreeAccel& accel() const { return *accel_; }
+  // Rays per packet of the batched kernels (EmbreeAccel::setPacketWidth), for tests.
+  void setPacketWidth(unsigned width) { accel_->setPacketWidth(width); }
   size_t triangleCount() const;
 
  private:

@@ -19,6 +19,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cstdint>
@@ -493,7 +494,8 @@ namespace ember {
 namespace {
 
 // accel/packet_tfar.h against the scalar loops it replaced in the intersect callback: every lane,
-// live or not, with finite, infinite, zero and negative tfar.
+// live or not, with finite, infinite, zero and negative tfar, for every packet width Embree calls
+// with (16, 8, 4, 1) and widths that leave a tail after the last whole vector.
 TEST(PacketTfar, VectorPassesEqualTheScalarLoops) {
   Rng rng(7, 1);
   const float special[] = {kInfinity,
@@ -506,29 +508,36 @@ TEST(PacketTfar, VectorPassesEqualTheScalarLoops) {
                            -kInfinity,
                            -0.0f,
                            std::numeric_limits<float>::denorm_min()};
-  for (int trial = 0; trial < 200; ++trial) {
-    alignas(64) float tfar[kPacketTfarLanes], expected[kPacketTfarLanes];
-    alignas(64) int valid[kPacketTfarLanes];
-    for (unsigned i = 0; i < kPacketTfarLanes; ++i) {
-      tfar[i] = rng.uniform() < 0.3f ? special[rng.nextU32() % 10] : 100.0f * rng.uniform();
-      valid[i] = rng.uniform() < 0.5f ? -1 : 0;
-    }
-    float saved[kPacketTfarLanes], savedExpected[kPacketTfarLanes];
-    std::memcpy(expected, tfar, sizeof(tfar));
-    for (unsigned i = 0; i < kPacketTfarLanes; ++i) {
-      savedExpected[i] = expected[i];
-      if (valid[i]) expected[i] = nextFloatUp(expected[i]);
-    }
-    widenLiveTfar16(tfar, valid, saved);
-    ASSERT_EQ(0, std::memcmp(saved, savedExpected, sizeof(saved))) << "trial " << trial;
-    ASSERT_EQ(0, std::memcmp(tfar, expected, sizeof(tfar))) << "trial " << trial;
+  for (const unsigned n : {16u, 8u, 4u, 1u, 13u, 7u}) {
+    for (int trial = 0; trial < 200; ++trial) {
+      // Lanes past n hold a sentinel that neither pass may touch.
+      alignas(64) float tfar[kPacketTfarLanes], expected[kPacketTfarLanes];
+      alignas(64) int valid[kPacketTfarLanes];
+      for (unsigned i = 0; i < kPacketTfarLanes; ++i) {
+        tfar[i] = i >= n                 ? -7.0f
+                  : rng.uniform() < 0.3f ? special[rng.nextU32() % 10]
+                                         : 100.0f * rng.uniform();
+        valid[i] = rng.uniform() < 0.5f ? -1 : 0;
+      }
+      float saved[kPacketTfarLanes], savedExpected[kPacketTfarLanes];
+      std::fill(saved, saved + kPacketTfarLanes, -9.0f);
+      std::fill(savedExpected, savedExpected + kPacketTfarLanes, -9.0f);
+      std::memcpy(expected, tfar, sizeof(tfar));
+      for (unsigned i = 0; i < n; ++i) {
+        savedExpected[i] = expected[i];
+        if (valid[i]) expected[i] = nextFloatUp(expected[i]);
+      }
+      widenLiveTfar(tfar, valid, saved, n);
+      ASSERT_EQ(0, std::memcmp(saved, savedExpected, sizeof(saved))) << "n " << n << " trial " << trial;
+      ASSERT_EQ(0, std::memcmp(tfar, expected, sizeof(tfar))) << "n " << n << " trial " << trial;
 
-    float result[kPacketTfarLanes];
-    for (unsigned i = 0; i < kPacketTfarLanes; ++i) result[i] = 1000.0f + float(i);
-    for (unsigned i = 0; i < kPacketTfarLanes; ++i)
-      if (valid[i]) expected[i] = result[i];
-    storeLiveTfar16(tfar, valid, result);
-    ASSERT_EQ(0, std::memcmp(tfar, expected, sizeof(tfar))) << "trial " << trial;
+      float result[kPacketTfarLanes];
+      for (unsigned i = 0; i < kPacketTfarLanes; ++i) result[i] = 1000.0f + float(i);
+      for (unsigned i = 0; i < n; ++i)
+        if (valid[i]) expected[i] = result[i];
+      storeLiveTfar(tfar, valid, result, n);
+      ASSERT_EQ(0, std::memcmp(tfar, expected, sizeof(tfar))) << "n " << n << " trial " << trial;
+    }
   }
 }
 
