@@ -67,6 +67,7 @@ struct BenchArgs {
   int repeat = 3;
   std::string json;
   std::string kernel = "wavefront";
+  std::string packetWidth = "auto";
   std::string caustics;  // "trace", "path", or empty: each scene's render.caustic_tracing
 };
 
@@ -101,10 +102,12 @@ int runBench(const BenchArgs& a) {
     const auto buildStart = Clock::now();
     scene.build();
     const double buildSeconds = secondsSince(buildStart);
+    report["machine"]["native_packet_width"] = scene.accel().packetWidth();
+    if (a.packetWidth != "auto") scene.setPacketWidth(unsigned(std::stoi(a.packetWidth)));
+    report["packet_width"] = scene.accel().packetWidth();
     if (const std::string w = unreachableLightsWarning(scene, scene.settings.strategy); !w.empty())
       std::fprintf(stderr, "ember: warning: %s: %s\n", path.c_str(), w.c_str());
     report["machine"]["isa"] = scene.accel().isaName();
-    report["machine"]["packet_width"] = scene.accel().packetWidth();
 
     const std::unique_ptr<Integrator> integrator = makeIntegrator(scene.settings, *parseKernel(a.kernel));
     RenderOptions options;
@@ -186,6 +189,9 @@ Runner addBenchCommand(CLI::App& app) {
   cmd->add_option("--kernel", args->kernel,
                   "wavefront (default), stream or scalar; see `ember render --help`")
       ->check(CLI::IsMember({"wavefront", "stream", "scalar"}));
+  cmd->add_option("--packet-width", args->packetWidth,
+                  "auto (default), 8 or 16 rays per packet; see `ember render --help`")
+      ->check(CLI::IsMember({"auto", "8", "16"}));
   cmd->add_option(
          "--caustics", args->caustics,
          "trace or path, as `ember render --caustics` (default: each scene's render.caustic_tracing)")

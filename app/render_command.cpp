@@ -38,6 +38,7 @@ struct RenderArgs {
   std::string strategy;
   std::string caustics;
   std::string kernel = "wavefront";
+  std::string packetWidth = "auto";
   std::string env;
   bool quiet = false;
   std::string checkpoint, resume, time;
@@ -215,6 +216,7 @@ int runRender(RenderArgs a) {
   Scene& scene = setup.scene;
   const RenderSettings& s = scene.settings;
   scene.build();
+  if (a.packetWidth != "auto") scene.setPacketWidth(unsigned(std::stoi(a.packetWidth)));
   if (const std::string w = unreachableLightsWarning(scene, s.strategy); !w.empty())
     std::fprintf(stderr, "ember: warning: %s\n", w.c_str());
   const double loadSeconds = std::chrono::duration<double>(Clock::now() - loadStart).count();
@@ -371,9 +373,14 @@ Runner addRenderCommand(CLI::App& app) {
                   "scene's render.caustic_tracing")
       ->check(CLI::IsMember({"trace", "path"}));
   cmd->add_option("--kernel", args->kernel,
-                  "How paths are traced, all giving the same image: wavefront (16-wide Embree packets, the "
-                  "default), stream (Embree ray streams) or scalar (one ray at a time, the reference)")
+                  "How paths are traced, all giving the same image: wavefront (Embree packets, the default), "
+                  "stream (Embree ray streams) or scalar (one ray at a time, the reference)")
       ->check(CLI::IsMember({"wavefront", "stream", "scalar"}));
+  cmd->add_option(
+         "--packet-width", args->packetWidth,
+         "Rays per packet of the wavefront and stream kernels: auto (the default: 16 where Embree "
+         "traverses 16-ray packets natively, as with AVX-512, else 8), 8 or 16; the image is the same")
+      ->check(CLI::IsMember({"auto", "8", "16"}));
   cmd->add_option("--env", args->env,
                   "Environment light: r,g,b (or one number) for a constant colour, or an equirectangular "
                   "EXR/HDR map; replaces the scene's");

@@ -40,6 +40,30 @@ TEST(BenchCommand, JsonReportsTheBuildAndTheRates) {
   EXPECT_EQ(scene.at("nonfinite_samples"), 0);
 }
 
+// --packet-width: the report says the width the render used, whatever this machine's native one
+// is; a width Embree has no packets of is refused before anything runs.
+TEST(BenchCommand, PacketWidthReachesTheReport) {
+  test::TempDir dir;
+  for (const int width : {8, 16}) {
+    const std::string out = dir.file("bench" + std::to_string(width) + ".json");
+    const test::CliResult r = test::runEmber("bench '" + test::sourcePath("scenes/cornell-point.json") +
+                                             "' --spp 1 --repeat 1 --packet-width " + std::to_string(width) +
+                                             " --json '" + out + "'");
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    std::ifstream in(out);
+    const nlohmann::json report = nlohmann::json::parse(in);
+    EXPECT_EQ(report.at("packet_width"), width);
+    const int native = report.at("machine").at("native_packet_width");
+    EXPECT_TRUE(native == 8 || native == 16) << native;
+  }
+  const test::CliResult bad =
+      test::runEmber("bench '" + test::sourcePath("scenes/cornell-point.json") +
+                     "' --spp 1 --packet-width 4 --json '" + dir.file("no.json") + "'");
+  EXPECT_NE(bad.exitCode, 0);
+  EXPECT_NE(bad.output.find("--packet-width"), std::string::npos) << bad.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("no.json")));
+}
+
 TEST(BenchCommand, MissingSceneNamesItAndWritesNoReport) {
   test::TempDir dir;
   const std::string out = dir.file("bench.json");
