@@ -37,8 +37,8 @@ void writeRay(RTCRayN* p, unsigned n, unsigned lane, const Ray& given) {
 void initFixedFields(RTCRayN* p, unsigned n) {
   for (unsigned lane = 0; lane < n; ++lane) {
     RTCRayN_time(p, n, lane) = 0.0f;
-    RTCRayN_mask(p, n, lane) =
-        0xFFFFFFFFu;  // Debian's Embree is built with ray masks: 0 would miss everything
+    // Debian's Embree is built with ray masks: 0 would miss everything.
+    RTCRayN_mask(p, n, lane) = 0xFFFFFFFFu;
     RTCRayN_id(p, n, lane) = lane;
     RTCRayN_flags(p, n, lane) = 0;
   }
