@@ -66,8 +66,8 @@ class EmbreeAccel {
   // own into packets of its width and calls the shapes' callbacks with those, after copying every
   // ray twice (measured in docs/performance.md). Where neither is native (SSE), 16.
   unsigned packetWidth() const { return packetWidth_; }
-  // Overrides the choice (8 or 16), so that tests can check that both widths give the same
-  // hits on any machine.
+  // Overrides the choice (8 or 16): `--packet-width`, and the tests that check that both widths
+  // give the same hits on any machine.
   void setPacketWidth(unsigned width);
   RTCScene rtcScene() const { return scene_; }  // for the raw-throughput benchmark
 

@@ -80,7 +80,7 @@ void PacketStorage::Free::operator()(float* p) const {
   std::free(p);
 }
 
-PacketStorage::PacketStorage(size_t capacity, size_t floatsPerRay)
+PacketStorage::PacketStorage(size_t capacity, size_t floatsPerRay, unsigned width)
     : capacity_(capacity), floatsPerRay_(floatsPerRay) {
   // Whole packets of the widest layout: every narrower one fits in them.
   const size_t floats = (capacity + kMaxWidth - 1) / kMaxWidth * kMaxWidth * floatsPerRay;
@@ -88,10 +88,12 @@ PacketStorage::PacketStorage(size_t capacity, size_t floatsPerRay)
   data_.reset(static_cast<float*>(std::aligned_alloc(64, std::max<size_t>(bytes, 64))));
   if (!data_) throw std::bad_alloc();
   std::fill(data_.get(), data_.get() + bytes / sizeof(float), 0.0f);
+  setWidth(width);
 }
 
 void PacketStorage::setWidth(unsigned width) {
-  width_ = checkedWidth(width);
+  if (checkedWidth(width) == width_) return;
+  width_ = width;
   shift_ = unsigned(std::countr_zero(width));
   stride_ = floatsPerRay_ * width;
   for (size_t k = 0; k < packets(capacity_); ++k)
@@ -101,17 +103,10 @@ void PacketStorage::setWidth(unsigned width) {
 }  // namespace detail
 
 ClosestHitBatch::ClosestHitBatch(size_t capacity, unsigned width)
-    : capacity_(capacity), storage_(capacity, kFloatsPerRayHit) {
-  storage_.setWidth(width);
-}
-
-void ClosestHitBatch::setWidth(unsigned width) {
-  size_ = 0;
-  if (width != storage_.width()) storage_.setWidth(width);
-}
+    : storage_(capacity, kFloatsPerRayHit, width) {}
 
 void ClosestHitBatch::push(const Ray& ray) {
-  if (size_ == capacity_) throw std::logic_error("ClosestHitBatch overflow");
+  if (size_ == storage_.capacity()) throw std::logic_error("ClosestHitBatch overflow");
   const unsigned n = storage_.width(), lane = storage_.laneOf(size_);
   RTCRayHitN* p = packetOf(size_);
   writeRay(RTCRayHitN_RayN(p, n), n, lane, ray);
@@ -159,18 +154,10 @@ bool ClosestHitBatch::hit(size_t i, RawHit& out) const {
   return true;
 }
 
-ShadowBatch::ShadowBatch(size_t capacity, unsigned width)
-    : capacity_(capacity), storage_(capacity, kFloatsPerRay) {
-  storage_.setWidth(width);
-}
-
-void ShadowBatch::setWidth(unsigned width) {
-  size_ = 0;
-  if (width != storage_.width()) storage_.setWidth(width);
-}
+ShadowBatch::ShadowBatch(size_t capacity, unsigned width) : storage_(capacity, kFloatsPerRay, width) {}
 
 void ShadowBatch::push(const Ray& ray) {
-  if (size_ == capacity_) throw std::logic_error("ShadowBatch overflow");
+  if (size_ == storage_.capacity()) throw std::logic_error("ShadowBatch overflow");
   writeRay(reinterpret_cast<RTCRayN*>(storage_.packetOf(size_)), storage_.width(), storage_.laneOf(size_),
            ray);
   ++size_;

@@ -28,9 +28,11 @@ namespace detail {
 // record (RTCRayHitN or RTCRayN) in floats.
 class PacketStorage {
  public:
-  PacketStorage(size_t capacity, size_t floatsPerRay);
-  // Lays the storage out as packets of `width` rays (8 or 16) with their fixed fields set.
+  PacketStorage(size_t capacity, size_t floatsPerRay, unsigned width);
+  // Lays the storage out as packets of `width` rays (8 or 16) with their fixed fields set, unless
+  // it is laid out so already.
   void setWidth(unsigned width);
+  size_t capacity() const { return capacity_; }
   unsigned width() const { return width_; }
   size_t packets(size_t rays) const { return (rays + width_ - 1) >> shift_; }
   float* packet(size_t k) const { return data_.get() + k * stride_; }
@@ -56,12 +58,15 @@ class ClosestHitBatch {
   static constexpr unsigned kDefaultWidth = 16;
   explicit ClosestHitBatch(size_t capacity, unsigned width = kDefaultWidth);
 
-  // Rays per packet, 8 or 16; changing it empties the batch.
-  void setWidth(unsigned width);
+  // Rays per packet, 8 or 16; empties the batch.
+  void setWidth(unsigned width) {
+    size_ = 0;
+    storage_.setWidth(width);
+  }
   unsigned width() const { return storage_.width(); }
   void clear() { size_ = 0; }
   size_t size() const { return size_; }
-  size_t capacity() const { return capacity_; }
+  size_t capacity() const { return storage_.capacity(); }
   // Appends a ray (tnear 0, tfar ray.tMax); its index is the size before the call.
   void push(const Ray& ray);
   void trace(const EmbreeAccel& accel, BatchTraversal traversal = BatchTraversal::Packets);
@@ -76,7 +81,6 @@ class ClosestHitBatch {
   RTCRayHitN* packetOf(size_t i) const { return reinterpret_cast<RTCRayHitN*>(storage_.packetOf(i)); }
   RTCHitN* hitsOf(size_t i) const { return RTCRayHitN_HitN(packetOf(i), storage_.width()); }
 
-  size_t capacity_;
   size_t size_ = 0;
   detail::PacketStorage storage_;
 };
@@ -86,8 +90,11 @@ class ShadowBatch {
   static constexpr unsigned kDefaultWidth = 16;
   explicit ShadowBatch(size_t capacity, unsigned width = kDefaultWidth);
 
-  // Rays per packet, 8 or 16; changing it empties the batch.
-  void setWidth(unsigned width);
+  // Rays per packet, 8 or 16; empties the batch.
+  void setWidth(unsigned width) {
+    size_ = 0;
+    storage_.setWidth(width);
+  }
   unsigned width() const { return storage_.width(); }
   void clear() { size_ = 0; }
   size_t size() const { return size_; }
@@ -100,7 +107,6 @@ class ShadowBatch {
   }
 
  private:
-  size_t capacity_;
   size_t size_ = 0;
   detail::PacketStorage storage_;
 };

@@ -93,7 +93,7 @@ class Scene {
   const CausticTracer& causticTracer() const { return causticTracer_; }
   Bounds bounds() const { return bounds_; }
   const EmbreeAccel& accel() const { return *accel_; }
-  // Rays per packet of the batched kernels (EmbreeAccel::setPacketWidth), for tests.
+  // Rays per packet of the batched kernels (EmbreeAccel::setPacketWidth): --packet-width, tests.
   void setPacketWidth(unsigned width) { accel_->setPacketWidth(width); }
   size_t triangleCount() const;
 
