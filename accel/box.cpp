@@ -3,7 +3,11 @@
 namespace ember {
 
 Box::Box(const Vec3& center, const Vec3& size, const glm::mat3& rotation)
-    : center_(center), half_(0.5f * size), rotation_(rotation) {}
+    : center_(center), half_(0.5f * size), rotation_(rotation) {
+  slab_.center = glm::dvec3(center_);
+  for (int k = 0; k < 3; ++k) slab_.axes[k] = glm::dvec3(rotation_[k]);
+  slab_.half = glm::dvec3(half_);
+}
 
 Bounds Box::bounds() const {
   Bounds b;
@@ -21,49 +25,31 @@ static Vec2 faceUv(const glm::dvec3& local, const Vec3& half, int axis) {
   return Vec2(float(0.5 + 0.5 * local[a] / half[a]), float(0.5 + 0.5 * local[b] / half[b]));
 }
 
-bool Box::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const {
-  const glm::dmat3 toLocal = glm::transpose(glm::dmat3(rotation_));
-  const glm::dvec3 o = toLocal * (glm::dvec3(ray.origin) - glm::dvec3(center_));
-  const glm::dvec3 d = toLocal * glm::dvec3(ray.dir);
-  double tNear = -kInfinity, tFar = kInfinity;
-  int nearAxis = -1, farAxis = -1;
-  for (int i = 0; i < 3; ++i) {
-    if (d[i] == 0.0) {
-      if (std::abs(o[i]) > half_[i]) return false;
-      continue;
-    }
-    double t0 = (-half_[i] - o[i]) / d[i];
-    double t1 = (half_[i] - o[i]) / d[i];
-    if (t0 > t1) std::swap(t0, t1);
-    if (t0 > tNear) {
-      tNear = t0;
-      nearAxis = i;
-    }
-    if (t1 < tFar) {
-      tFar = t1;
-      farAxis = i;
-    }
-  }
-  if (tNear > tFar) return false;
-  double t;
-  int axis;
-  if (tNear > tMin && tNear < tMax) {
-    t = tNear;
-    axis = nearAxis;
-  } else if (tFar > tMin && tFar < tMax) {
-    t = tFar;  // the ray starts inside the box
-    axis = farAxis;
-  } else {
-    return false;
-  }
-  if (axis < 0) return false;
-  const glm::dvec3 local = o + t * d;
+LocalHit Box::faceHit(const BoxCrossing& crossing) const {
   Vec3 nLocal(0.0f);
-  nLocal[axis] = local[axis] > 0.0 ? 1.0f : -1.0f;
-  hit.t = float(t);
+  nLocal[crossing.axis] = crossing.local[crossing.axis] > 0.0 ? 1.0f : -1.0f;
+  LocalHit hit;
+  hit.t = float(crossing.t);
   hit.ng = rotation_ * nLocal;
-  hit.uv = faceUv(local, half_, axis);
+  hit.uv = faceUv(crossing.local, half_, crossing.axis);
+  return hit;
+}
+
+bool Box::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const {
+  BoxCrossing crossing;
+  if (!slab_.cross(ray, tMin, tMax, crossing)) return false;
+  hit = faceHit(crossing);
   return true;
+}
+
+void Box::intersectLanes(const RayLanes& rays, LaneHits& out) const {
+  BoxLanes crossings;
+  out.mask = boxCrossings(rays, slab_, candidateLanes(rays), crossings);
+  for (uint32_t bits = out.mask; bits != 0; bits &= bits - 1) {
+    const unsigned i = unsigned(__builtin_ctz(bits));
+    const glm::dvec3 local(crossings.local[0][i], crossings.local[1][i], crossings.local[2][i]);
+    out.hit[i] = faceHit({crossings.t[i], local, int(crossings.axis[i])});
+  }
 }
 
 SurfacePoint Box::projectToSurface(const Vec3& p, const LocalHit& hit) const {

@@ -3,6 +3,7 @@
 // 1986). UV on each face: the face's two in-plane local coordinates mapped to [0, 1].
 #pragma once
 
+#include "accel/quadric_lanes.h"
 #include "accel/shape.h"
 
 namespace ember {
@@ -15,6 +16,7 @@ class Box final : public Shape {
   std::string_view typeName() const override { return "box"; }
   Bounds bounds() const override;
   bool intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const override;
+  void intersectLanes(const RayLanes& rays, LaneHits& out) const override;
   SurfacePoint projectToSurface(const Vec3& p, const LocalHit& hit) const override;
   float area() const override;
   ShapeSample sampleArea(Vec2 u) const override;
@@ -23,6 +25,9 @@ class Box final : public Shape {
   Vec3 center_;
   Vec3 half_;
   glm::mat3 rotation_;  // local -> world
+  ExactBox slab_;
+
+  LocalHit faceHit(const BoxCrossing& crossing) const;
 };
 
 }  // namespace ember

@@ -1,6 +1,6 @@
 #include "accel/cone.h"
 
-#include "accel/solve.h"
+#include <algorithm>
 
 namespace ember {
 
@@ -11,7 +11,16 @@ Cone::Cone(const Vec3& baseCenter, const Vec3& apex, float radius, bool capBase)
       height_(glm::length(apex - baseCenter)),
       radius_(radius),
       capBase_(capBase),
-      cap_(baseCenter, -glm::normalize(apex - baseCenter), radius) {}
+      cap_(baseCenter, -glm::normalize(apex - baseCenter), radius) {
+  lateral_.base = glm::dvec3(base_);
+  lateral_.s = glm::dvec3(axis_.s);
+  lateral_.t = glm::dvec3(axis_.t);
+  lateral_.n = glm::dvec3(axis_.n);
+  lateral_.height = double(height_);
+  lateral_.cone = true;
+  const double k = double(radius_) / double(height_);
+  lateral_.k2 = k * k;
+}
 
 Bounds Cone::bounds() const {
   Bounds b;
@@ -26,38 +35,58 @@ Vec3 Cone::lateralNormal(float cosPhi, float sinPhi) const {
   return glm::normalize(axis_.s * cosPhi + axis_.t * sinPhi + axis_.n * k);
 }
 
+LocalHit Cone::lateralHit(const LateralRoot& root) const {
+  // The direction (cos phi, sin phi) around the axis; at the apex, where it has none, phi = 0.
+  const double len = std::sqrt(root.x * root.x + root.y * root.y);
+  const float cosPhi = len > 0.0 ? float(root.x / len) : 1.0f;
+  const float sinPhi = len > 0.0 ? float(root.y / len) : 0.0f;
+  LocalHit hit;
+  hit.t = float(root.t);
+  hit.ng = lateralNormal(cosPhi, sinPhi);
+  hit.uv = Vec2(0.0f, float(root.z / double(height_)));
+  return hit;
+}
+
 bool Cone::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const {
   bool found = false;
-  const glm::dvec3 rel = glm::dvec3(ray.origin) - glm::dvec3(base_);
-  const glm::dvec3 s(axis_.s), t(axis_.t), n(axis_.n), d(ray.dir);
-  const double ox = glm::dot(rel, s), oy = glm::dot(rel, t), oz = glm::dot(rel, n);
-  const double dx = glm::dot(d, s), dy = glm::dot(d, t), dz = glm::dot(d, n);
-  const double h = height_;
-  const double k = double(radius_) / h;
-  const double k2 = k * k;
-  const double hz = h - oz;
-  const double a = dx * dx + dy * dy - k2 * dz * dz;
-  const double b = 2.0 * (ox * dx + oy * dy + k2 * hz * dz);
-  const double c = ox * ox + oy * oy - k2 * hz * hz;
-  double roots[2];
-  if (solveQuadratic(a, b, c, roots[0], roots[1])) {
-    for (double root : roots) {
-      if (root <= tMin || root >= tMax) continue;
-      const double z = oz + root * dz;
-      if (z < 0.0 || z > h) continue;  // also rejects the mirror-image nappe above the apex
-      const double x = ox + root * dx, y = oy + root * dy;
-      double phi = std::atan2(y, x);
-      if (phi < 0.0) phi += 2.0 * std::numbers::pi;
-      hit.t = float(root);
-      hit.ng = lateralNormal(float(std::cos(phi)), float(std::sin(phi)));
-      hit.uv = Vec2(float(phi / (2.0 * std::numbers::pi)), float(z / h));
-      tMax = hit.t;
-      found = true;
-      break;
-    }
+  LateralRoot root;
+  if (lateral_.nearestRoot(ray, tMin, tMax, root)) {
+    hit = lateralHit(root);
+    tMax = hit.t;
+    found = true;
   }
   if (capBase_ && cap_.intersect(ray, tMin, tMax, hit)) found = true;
   return found;
+}
+
+// intersect() for the whole block: the side, then the base within what is left of the interval.
+void Cone::intersectLanes(const RayLanes& rays, LaneHits& out) const {
+  const uint32_t live = candidateLanes(rays);
+  LateralLanes roots;
+  out.mask = lateralRoots(rays, lateral_, live, roots);
+  alignas(64) float tMax[RayLanes::kMaxLanes] = {};
+  std::copy_n(rays.tfar, rays.n, tMax);
+  for (uint32_t bits = out.mask; bits != 0; bits &= bits - 1) {
+    const unsigned i = unsigned(__builtin_ctz(bits));
+    out.hit[i] = lateralHit({roots.t[i], roots.x[i], roots.y[i], roots.z[i]});
+    tMax[i] = out.hit[i].t;
+  }
+  if (!capBase_) return;
+  DiscLanes crossings;
+  const uint32_t capped = discCrossings(rays, cap_.exact, tMax, live, crossings);
+  for (uint32_t bits = capped; bits != 0; bits &= bits - 1) {
+    const unsigned i = unsigned(__builtin_ctz(bits));
+    out.hit[i] = cap_.hitAt({crossings.t[i], crossings.x[i], crossings.y[i]});
+  }
+  out.mask |= capped;
+}
+
+Vec2 Cone::surfaceUv(const LocalHit& hit) const {
+  if (glm::dot(hit.ng, axis_.n) < -0.99f) return hit.uv;  // the base's planar mapping
+  // The normal's component across the axis points along (cos phi, sin phi).
+  float phi = std::atan2(glm::dot(hit.ng, axis_.t), glm::dot(hit.ng, axis_.s));
+  if (phi < 0.0f) phi += 2.0f * kPi;
+  return {phi / (2.0f * kPi), hit.uv.y};
 }
 
 SurfacePoint Cone::projectToSurface(const Vec3& p, const LocalHit& hit) const {

@@ -1,6 +1,6 @@
 #include "accel/cylinder.h"
 
-#include "accel/solve.h"
+#include <algorithm>
 
 namespace ember {
 
@@ -11,7 +11,14 @@ Cylinder::Cylinder(const Vec3& p0, const Vec3& p1, float radius, bool caps)
       radius_(radius),
       caps_(caps),
       cap0_(p0, -glm::normalize(p1 - p0), radius),
-      cap1_(p1, glm::normalize(p1 - p0), radius) {}
+      cap1_(p1, glm::normalize(p1 - p0), radius) {
+  lateral_.base = glm::dvec3(p0_);
+  lateral_.s = glm::dvec3(axis_.s);
+  lateral_.t = glm::dvec3(axis_.t);
+  lateral_.n = glm::dvec3(axis_.n);
+  lateral_.height = double(height_);
+  lateral_.r2 = double(radius_) * double(radius_);
+}
 
 Bounds Cylinder::bounds() const {
   Bounds b;
@@ -20,32 +27,21 @@ Bounds Cylinder::bounds() const {
   return b;
 }
 
+LocalHit Cylinder::lateralHit(const LateralRoot& root) const {
+  LocalHit hit;
+  hit.t = float(root.t);
+  hit.ng = glm::normalize(axis_.s * float(root.x) + axis_.t * float(root.y));
+  hit.uv = Vec2(0.0f, float(root.z / double(height_)));
+  return hit;
+}
+
 bool Cylinder::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const {
   bool found = false;
-  // Lateral surface x^2 + y^2 = r^2, 0 <= z <= h, in the axis frame, solved in double.
-  const glm::dvec3 rel = glm::dvec3(ray.origin) - glm::dvec3(p0_);
-  const glm::dvec3 s(axis_.s), t(axis_.t), n(axis_.n), d(ray.dir);
-  const double ox = glm::dot(rel, s), oy = glm::dot(rel, t), oz = glm::dot(rel, n);
-  const double dx = glm::dot(d, s), dy = glm::dot(d, t), dz = glm::dot(d, n);
-  const double a = dx * dx + dy * dy;
-  const double b = 2.0 * (ox * dx + oy * dy);
-  const double c = ox * ox + oy * oy - double(radius_) * radius_;
-  double roots[2];
-  if (a > 0.0 && solveQuadratic(a, b, c, roots[0], roots[1])) {
-    for (double root : roots) {
-      if (root <= tMin || root >= tMax) continue;
-      const double z = oz + root * dz;
-      if (z < 0.0 || z > height_) continue;
-      const double x = ox + root * dx, y = oy + root * dy;
-      double phi = std::atan2(y, x);
-      if (phi < 0.0) phi += 2.0 * std::numbers::pi;
-      hit.t = float(root);
-      hit.ng = glm::normalize(axis_.s * float(x) + axis_.t * float(y));
-      hit.uv = Vec2(float(phi / (2.0 * std::numbers::pi)), float(z / height_));
-      tMax = hit.t;
-      found = true;
-      break;
-    }
+  LateralRoot root;
+  if (lateral_.nearestRoot(ray, tMin, tMax, root)) {
+    hit = lateralHit(root);
+    tMax = hit.t;
+    found = true;
   }
   if (caps_) {
     if (cap0_.intersect(ray, tMin, tMax, hit)) {
@@ -55,6 +51,38 @@ bool Cylinder::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) 
     if (cap1_.intersect(ray, tMin, tMax, hit)) found = true;
   }
   return found;
+}
+
+// intersect() for the whole block: the side, then each cap within what is left of the interval.
+void Cylinder::intersectLanes(const RayLanes& rays, LaneHits& out) const {
+  const uint32_t live = candidateLanes(rays);
+  LateralLanes roots;
+  out.mask = lateralRoots(rays, lateral_, live, roots);
+  alignas(64) float tMax[RayLanes::kMaxLanes] = {};
+  std::copy_n(rays.tfar, rays.n, tMax);
+  for (uint32_t bits = out.mask; bits != 0; bits &= bits - 1) {
+    const unsigned i = unsigned(__builtin_ctz(bits));
+    out.hit[i] = lateralHit({roots.t[i], roots.x[i], roots.y[i], roots.z[i]});
+    tMax[i] = out.hit[i].t;
+  }
+  if (!caps_) return;
+  for (const DiscGeometry* cap : {&cap0_, &cap1_}) {
+    DiscLanes crossings;
+    const uint32_t capped = discCrossings(rays, cap->exact, tMax, live, crossings);
+    for (uint32_t bits = capped; bits != 0; bits &= bits - 1) {
+      const unsigned i = unsigned(__builtin_ctz(bits));
+      out.hit[i] = cap->hitAt({crossings.t[i], crossings.x[i], crossings.y[i]});
+      tMax[i] = out.hit[i].t;
+    }
+    out.mask |= capped;
+  }
+}
+
+Vec2 Cylinder::surfaceUv(const LocalHit& hit) const {
+  if (std::abs(glm::dot(hit.ng, axis_.n)) > 0.5f) return hit.uv;  // a cap's planar mapping
+  float phi = std::atan2(glm::dot(hit.ng, axis_.t), glm::dot(hit.ng, axis_.s));
+  if (phi < 0.0f) phi += 2.0f * kPi;
+  return {phi / (2.0f * kPi), hit.uv.y};
 }
 
 SurfacePoint Cylinder::projectToSurface(const Vec3& p, const LocalHit& hit) const {

@@ -4,22 +4,13 @@
 
 namespace ember {
 
-bool DiscGeometry::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const {
-  const glm::dvec3 n(frame.n);
-  const double denom = glm::dot(glm::dvec3(ray.dir), n);
-  if (denom == 0.0) return false;  // parallel: a zero-thickness disc is never hit edge-on
-  const glm::dvec3 oc = glm::dvec3(center) - glm::dvec3(ray.origin);
-  const double t = glm::dot(oc, n) / denom;
-  if (t <= tMin || t >= tMax) return false;
-  const glm::dvec3 rel = glm::dvec3(ray.origin) + t * glm::dvec3(ray.dir) - glm::dvec3(center);
-  const double x = glm::dot(rel, glm::dvec3(frame.s));
-  const double y = glm::dot(rel, glm::dvec3(frame.t));
-  const double r = radius;
-  if (x * x + y * y > r * r) return false;
-  hit.t = float(t);
-  hit.ng = frame.n;
-  hit.uv = Vec2(float(0.5 + 0.5 * x / r), float(0.5 - 0.5 * y / r));
-  return true;
+DiscGeometry::DiscGeometry(const Vec3& c, const Vec3& normal, float r)
+    : center(c), frame(normal), radius(r), plane(DoublePlane::through(c, normal)) {
+  exact.center = glm::dvec3(c);
+  exact.n = glm::dvec3(frame.n);
+  exact.s = glm::dvec3(frame.s);
+  exact.t = glm::dvec3(frame.t);
+  exact.radius = double(r);
 }
 
 SurfacePoint DiscGeometry::projectToSurface(const Vec3& p, float rimMargin) const {
@@ -43,6 +34,15 @@ void DiscGeometry::extendBounds(Bounds& b) const {
   const Vec3 e = radius * glm::sqrt(glm::max(Vec3(0.0f), Vec3(1.0f) - frame.n * frame.n));
   b.extend(center - e);
   b.extend(center + e);
+}
+
+void Disc::intersectLanes(const RayLanes& rays, LaneHits& out) const {
+  DiscLanes crossings;
+  out.mask = discCrossings(rays, disc_.exact, rays.tfar, candidateLanes(rays), crossings);
+  for (uint32_t bits = out.mask; bits != 0; bits &= bits - 1) {
+    const unsigned i = unsigned(__builtin_ctz(bits));
+    out.hit[i] = disc_.hitAt({crossings.t[i], crossings.x[i], crossings.y[i]});
+  }
 }
 
 Bounds Disc::bounds() const {

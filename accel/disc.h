@@ -3,6 +3,7 @@
 // square texture maps onto the disc's bounding square. Also the caps of cylinders and cones.
 #pragma once
 
+#include "accel/quadric_lanes.h"
 #include "accel/shape.h"
 
 namespace ember {
@@ -14,9 +15,19 @@ struct DiscGeometry {
   float radius;
 
   DoublePlane plane;  // through the centre, with frame.n
-  DiscGeometry(const Vec3& c, const Vec3& normal, float r)
-      : center(c), frame(normal), radius(r), plane(DoublePlane::through(c, normal)) {}
-  bool intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const;
+  ExactDisc exact;    // the intersection routine's parameters, in double
+  DiscGeometry(const Vec3& c, const Vec3& normal, float r);
+  bool intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const {
+    DiscCrossing crossing;
+    if (!exact.cross(ray, tMin, tMax, crossing)) return false;
+    hit = hitAt(crossing);
+    return true;
+  }
+  // The hit of a crossing that exact.cross or discCrossings found.
+  LocalHit hitAt(const DiscCrossing& c) const {
+    const double r = radius;
+    return {float(c.t), frame.n, Vec2(float(0.5 + 0.5 * c.x / r), float(0.5 - 0.5 * c.y / r))};
+  }
   ShapeSample sampleArea(Vec2 u) const;
   // Onto the disc's plane; as a cap, also at least `rimMargin` inside the rim (accel/shape.h).
   SurfacePoint projectToSurface(const Vec3& p, float rimMargin = 0.0f) const;
@@ -33,6 +44,7 @@ class Disc final : public Shape {
   bool intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const override {
     return disc_.intersect(ray, tMin, tMax, hit);
   }
+  void intersectLanes(const RayLanes& rays, LaneHits& out) const override;
   SurfacePoint projectToSurface(const Vec3& p, const LocalHit&) const override {
     return disc_.projectToSurface(p);
   }

@@ -4,6 +4,7 @@
 #include <hwy/foreach_target.h>  // must come before highway.h
 #include <hwy/highway.h>
 
+#include "accel/double_lanes-inl.h"
 #include "accel/shape.h"
 #include "accel/shape_lanes.h"
 
@@ -184,57 +185,36 @@ uint32_t SphereCandidates(const RayLanes& rays, const Vec3& center, float radius
 
 // Sphere::intersect for every candidate lane at once, in double precision: the same operations
 // in the same order (this file is compiled with -ffp-contract=off, and IEEE division and square
-// root round exactly), so each lane's hit equals the scalar routine's bit for bit. Lanes whose
-// direction has zero length (a = 0, solveQuadratic's linear branch) are left to the caller. On
-// the HWY_SCALAR and EMU128 targets (CPUs without SSSE3) DemoteTo clamps a t beyond FLT_MAX to
+// root round exactly), so each lane's hit equals the scalar routine's bit for bit. On the
+// HWY_SCALAR and EMU128 targets (CPUs without SSSE3) DemoteTo clamps a t beyond FLT_MAX to
 // FLT_MAX where float(t) gives infinity: only a ray whose direction is ~1e-30 long can reach it.
-using D64 = hn::CappedTag<double, RayLanes::kMaxLanes / 2>;
-using V64 = hn::Vec<D64>;
-
-HWY_INLINE V64 dot64(const V64& ax, const V64& ay, const V64& az, const V64& bx, const V64& by,
-                     const V64& bz) {
-  return hn::Add(hn::Add(hn::Mul(ax, bx), hn::Mul(ay, by)), hn::Mul(az, bz));  // glm: (x + y) + z
-}
-
 uint32_t SphereHitsKernel(const RayLanes& rays, const Vec3& center, float radius, uint32_t candidates,
                           SphereHits& out) {
   const D64 d;
   const hn::Rebind<float, D64> df;
   const unsigned step = unsigned(hn::Lanes(d));
-  const V64 cx = hn::Set(d, double(center.x)), cy = hn::Set(d, double(center.y)),
-            cz = hn::Set(d, double(center.z));
+  const Vec3V64 c = splat64(d, double(center.x), double(center.y), double(center.z));
   const V64 r2 = hn::Set(d, double(radius) * double(radius));
-  const V64 zero = hn::Zero(d), two = hn::Set(d, 2.0), four = hn::Set(d, 4.0), half = hn::Set(d, -0.5),
-            one = hn::Set(d, 1.0);
-  uint32_t hits = 0, unsolved = 0;
+  const V64 two = hn::Set(d, 2.0), one = hn::Set(d, 1.0);
+  uint32_t hits = 0;
   for (unsigned i = 0; i < rays.n; i += step) {
-    const uint8_t laneBits = uint8_t((candidates >> i) & ((1u << step) - 1u));
-    if (laneBits == 0) continue;
-    const auto live = hn::LoadMaskBits(d, &laneBits);
-    auto load = [&](const float* p) { return hn::PromoteTo(d, hn::LoadU(df, p + i)); };
-    const V64 ox = hn::Sub(load(rays.org[0]), cx), oy = hn::Sub(load(rays.org[1]), cy),
-              oz = hn::Sub(load(rays.org[2]), cz);
-    const V64 dx = load(rays.dir[0]), dy = load(rays.dir[1]), dz = load(rays.dir[2]);
-    const V64 tMin = load(rays.tnear), tMax = load(rays.tfar);
+    const M64 live = blockMask(d, candidates, i);
+    if (hn::AllFalse(d, live)) continue;
+    const V64 ox = hn::Sub(loadPromoted(d, rays.org[0], i), c.x),
+              oy = hn::Sub(loadPromoted(d, rays.org[1], i), c.y),
+              oz = hn::Sub(loadPromoted(d, rays.org[2], i), c.z);
+    const V64 dx = loadPromoted(d, rays.dir[0], i), dy = loadPromoted(d, rays.dir[1], i),
+              dz = loadPromoted(d, rays.dir[2], i);
+    const V64 tMin = loadPromoted(d, rays.tnear, i), tMax = loadPromoted(d, rays.tfar, i);
     const V64 a = dot64(dx, dy, dz, dx, dy, dz);
     const V64 b = hn::Mul(two, dot64(ox, oy, oz, dx, dy, dz));
-    const V64 c = hn::Sub(dot64(ox, oy, oz, ox, oy, oz), r2);
-    // solveQuadratic (accel/solve.h).
-    const auto flat = hn::Eq(a, zero);
-    const V64 discrim = hn::Sub(hn::Mul(b, b), hn::Mul(hn::Mul(four, a), c));
-    const auto real = hn::Not(hn::Lt(discrim, zero));
-    const V64 root = hn::Sqrt(discrim);
-    const V64 q = hn::Mul(half, hn::IfThenElse(hn::Lt(b, zero), hn::Sub(b, root), hn::Add(b, root)));
-    V64 t0 = hn::Div(q, a);
-    // q != 0.0 as C++ has it (true for NaN): not Ne, which is an ordered compare on AVX2/AVX-512.
-    V64 t1 = hn::IfThenElse(hn::Not(hn::Eq(q, zero)), hn::Div(c, q), t0);
-    const auto swap = hn::Gt(t0, t1);
-    const V64 lo = hn::IfThenElse(swap, t1, t0), hi = hn::IfThenElse(swap, t0, t1);
+    const V64 cc = hn::Sub(dot64(ox, oy, oz, ox, oy, oz), r2);
+    const QuadraticRoots roots = solveQuadraticLanes(d, a, b, cc);
     // The nearer root within (tMin, tMax), else the farther one.
-    const auto outside = [&](const V64& t) { return hn::Or(hn::Le(t, tMin), hn::Ge(t, tMax)); };
-    const auto loOut = outside(lo);
-    const V64 t = hn::IfThenElse(loOut, hi, lo);
-    const auto hit = hn::AndNot(flat, hn::And(live, hn::And(real, hn::Not(hn::And(loOut, outside(hi))))));
+    const M64 loOut = outsideInterval(roots.t0, tMin, tMax);
+    const V64 t = hn::IfThenElse(loOut, roots.t1, roots.t0);
+    const M64 hit =
+        hn::And(live, hn::And(roots.real, hn::Not(hn::And(loOut, outsideInterval(roots.t1, tMin, tMax)))));
     // The unit normal: glm::normalize(oc + t d) = v * (1 / sqrt(dot(v, v))).
     const V64 lx = hn::Add(ox, hn::Mul(t, dx)), ly = hn::Add(oy, hn::Mul(t, dy)),
               lz = hn::Add(oz, hn::Mul(t, dz));
@@ -243,13 +223,8 @@ uint32_t SphereHitsKernel(const RayLanes& rays, const Vec3& center, float radius
     hn::StoreU(hn::DemoteTo(df, hn::Mul(lx, inv)), df, out.ng[0] + i);
     hn::StoreU(hn::DemoteTo(df, hn::Mul(ly, inv)), df, out.ng[1] + i);
     hn::StoreU(hn::DemoteTo(df, hn::Mul(lz, inv)), df, out.ng[2] + i);
-    uint8_t bits[8] = {};
-    hn::StoreMaskBits(d, hit, bits);
-    hits |= uint32_t(bits[0]) << i;
-    hn::StoreMaskBits(d, hn::And(live, flat), bits);
-    unsolved |= uint32_t(bits[0]) << i;
+    hits |= blockBits(d, hit, i);
   }
-  out.unsolved = unsolved;
   return hits;
 }
 
@@ -267,10 +242,9 @@ uint32_t PlaneCrossingsKernel(const RayLanes& rays, const DoublePlane& plane, co
   const V64 zero = hn::Zero(d);
   uint32_t hits = 0;
   for (unsigned i = 0; i < rays.n; i += step) {
-    const uint8_t laneBits = uint8_t((lanes >> i) & ((1u << step) - 1u));
-    if (laneBits == 0) continue;
-    const auto live = hn::LoadMaskBits(d, &laneBits);
-    auto load = [&](const float* p) { return hn::PromoteTo(d, hn::LoadU(df, p + i)); };
+    const M64 live = blockMask(d, lanes, i);
+    if (hn::AllFalse(d, live)) continue;
+    auto load = [&](const float* p) { return loadPromoted(d, p, i); };
     const V64 ox = load(rays.org[0]), oy = load(rays.org[1]), oz = load(rays.org[2]);
     const V64 dx = load(rays.dir[0]), dy = load(rays.dir[1]), dz = load(rays.dir[2]);
     const V64 denom = dot64(nx, ny, nz, dx, dy, dz);
@@ -289,9 +263,7 @@ uint32_t PlaneCrossingsKernel(const RayLanes& rays, const DoublePlane& plane, co
       hn::StoreU(hn::DemoteTo(df, b1), df, out.b[0] + i);
       hn::StoreU(hn::DemoteTo(df, b2), df, out.b[1] + i);
     }
-    uint8_t bits[8] = {};
-    hn::StoreMaskBits(d, hit, bits);
-    hits |= uint32_t(bits[0]) << i;
+    hits |= blockBits(d, hit, i);
   }
   return hits;
 }

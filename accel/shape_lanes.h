@@ -87,11 +87,10 @@ uint32_t sphereCandidates(const RayLanes& rays, const Vec3& center, float radius
 
 // Sphere::intersect of the lanes in `candidates`, all at once in double precision and equal to it
 // bit for bit: bit i of the result set when lane i hits, with its t and unit normal in lane i of
-// `out`. Lanes in `unsolved` (a zero direction) are not decided and need the scalar routine.
+// `out`.
 struct SphereHits {
   alignas(64) float t[RayLanes::kMaxLanes];
   alignas(64) float ng[3][RayLanes::kMaxLanes];
-  uint32_t unsolved = 0;
 };
 uint32_t sphereHits(const RayLanes& rays, const Vec3& center, float radius, uint32_t candidates,
                     SphereHits& out);

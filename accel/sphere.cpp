@@ -47,10 +47,6 @@ void Sphere::intersectLanes(const RayLanes& rays, LaneHits& out) const {
     const unsigned i = unsigned(__builtin_ctz(bits));
     out.hit[i] = LocalHit{lanes.t[i], Vec3(lanes.ng[0][i], lanes.ng[1][i], lanes.ng[2][i]), Vec2(0.0f)};
   }
-  for (uint32_t bits = lanes.unsolved; bits != 0; bits &= bits - 1) {
-    const unsigned i = unsigned(__builtin_ctz(bits));
-    if (intersect(rays.ray(i), rays.tnear[i], rays.tfar[i], out.hit[i])) out.mask |= 1u << i;
-  }
 }
 
 SurfacePoint Sphere::projectToSurface(const Vec3& p, const LocalHit&) const {

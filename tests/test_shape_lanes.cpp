@@ -8,7 +8,9 @@
 // and far from it. The filters must also reject most rays that miss, and the flat shapes' kernel
 // settle most hits, or they would save nothing.
 #include "accel/box.h"
+#include "accel/cone.h"
 #include "accel/cylinder.h"
+#include "accel/disc.h"
 #include "accel/flipped_shape.h"
 #include "accel/packet_tfar.h"
 #include "accel/sphere.h"
@@ -189,8 +191,9 @@ struct ShapeCase {
   float size;
   Vec3 center;
   bool hasFilter;  // shapes without one keep every live lane
-  // The lanes' hits equal intersect()'s bit for bit (the sphere's double-precision kernel), not
-  // only to rounding (the flat shapes' settled hits come from another formula).
+  // The lanes' hits equal intersect()'s bit for bit (the double-precision kernels of the sphere, disc,
+  // cylinder, cone and box), not only to rounding (the flat shapes' settled hits come from another
+  // formula).
   bool exactLanes = false;
 };
 
@@ -259,8 +262,21 @@ std::vector<ShapeCase> cases(const Vec3& at, float s) {
       std::make_unique<Triangle>(
           std::array<Vec3, 3>{at, at + s * Vec3(1, 0, 0), at + s * Vec3(0.5f, 1e-3f, 0)}, triUv),
       true);
-  add("cylinder (no filter)", std::make_unique<Cylinder>(at - s * u, at + s * u, 0.5f * s, true), false);
-  add("box (no filter)", std::make_unique<Box>(at, Vec3(s), glm::mat3(1.0f)), false);
+  // The shapes whose double-precision kernels mirror intersect() (accel/quadric_lanes.h): no
+  // filter, every hit bit for bit.
+  const size_t firstExact = out.size();
+  add("capped cylinder", std::make_unique<Cylinder>(at - s * u, at + s * u, 0.5f * s, true), false);
+  add("open cylinder", std::make_unique<Cylinder>(at - s * w, at + 0.3f * s * w, 0.8f * s, false), false);
+  add("capped cone", std::make_unique<Cone>(at - s * u, at + s * u, 0.7f * s, true), false);
+  add("open cone", std::make_unique<Cone>(at + s * w, at - s * w, 0.4f * s, false), false);
+  add("flat cone", std::make_unique<Cone>(at, at + 0.05f * s * u, s, true), false);
+  add("flipped cone",
+      std::make_unique<FlippedShape>(std::make_unique<Cone>(at - s * u, at + s * u, 0.7f * s, true)), false);
+  add("disc", std::make_unique<Disc>(at, w, s), false);
+  add("axis box", std::make_unique<Box>(at, Vec3(s), glm::mat3(1.0f)), false);
+  add("rotated box", std::make_unique<Box>(at, s * Vec3(1.0f, 0.3f, 2.0f), glm::mat3(u, w, glm::cross(u, w))),
+      false);
+  for (size_t k = firstExact; k < out.size(); ++k) out[k].exactLanes = true;
   return out;
 }
 
@@ -496,6 +512,61 @@ namespace {
 // accel/packet_tfar.h against the scalar loops it replaced in the intersect callback: every lane,
 // live or not, with finite, infinite, zero and negative tfar, for every packet width Embree calls
 // with (16, 8, 4, 1) and widths that leave a tail after the last whole vector.
+// The branches of the exact routines that only degenerate directions reach, lane by lane against
+// intersect(): a cone's rays parallel to a generator (the quadratic's linear branch), a cylinder's
+// along its axis, rays parallel to a disc, and a box's rays with zero components (the slab
+// test's parallel case), inside and outside the slabs.
+TEST(ShapeLanes, DegenerateDirectionsGetTheScalarResult) {
+  const Vec3 base(0.2f, -0.1f, 0.3f), apex(0.2f, 1.9f, 0.3f);
+  const Cone cone(base, apex, 1.0f, true);
+  const Cylinder cylinder(base, apex, 0.5f, true);
+  const Disc disc(base, Vec3(0.0f, 1.0f, 0.0f), 1.0f);
+  const Box box(base, Vec3(1.0f, 2.0f, 0.5f), glm::mat3(1.0f));
+  Rng rng(4, 11);
+  for (const Shape* shape : {static_cast<const Shape*>(&cone), static_cast<const Shape*>(&cylinder),
+                             static_cast<const Shape*>(&disc), static_cast<const Shape*>(&box)}) {
+    SCOPED_TRACE(std::string(shape->typeName()));
+    int hitCount = 0;
+    for (int b = 0; b < 50; ++b) {
+      Block block;
+      for (unsigned i = 0; i < RayLanes::kMaxLanes; ++i) {
+        const Vec3 o = base + 2.5f * (Vec3(rng.uniform(), rng.uniform(), rng.uniform()) - 0.5f);
+        const float phi = 2.0f * kPi * rng.uniform();
+        Vec3 d;
+        switch (i % 4) {
+          case 0:  // along a generator of the cone (slope: radius 1 over height 2), up or down
+            d = glm::normalize(Vec3(std::cos(phi), (rng.uniform() < 0.5f ? -2.0f : 2.0f), std::sin(phi)));
+            break;
+          case 1:  // along the axis
+            d = Vec3(0.0f, rng.uniform() < 0.5f ? -1.0f : 1.0f, 0.0f);
+            break;
+          case 2:  // parallel to the disc and the box's y faces
+            d = Vec3(std::cos(phi), 0.0f, std::sin(phi));
+            break;
+          default:  // along a box axis
+            d = Vec3(0.0f);
+            d[int(rng.uniform() * 2.99f)] = rng.uniform() < 0.5f ? -1.0f : 1.0f;
+        }
+        block.set(i, Ray{o, d}, rng.uniform() < 0.9f);
+      }
+      LaneHits hits;
+      shape->intersectLanes(block.lanes(), hits);
+      for (unsigned i = 0; i < RayLanes::kMaxLanes; ++i) {
+        LocalHit h;
+        const bool hit =
+            block.valid[i] == -1 && shape->intersect(block.lanes().ray(i), block.tnear[i], block.tfar[i], h);
+        ASSERT_EQ(((hits.mask >> i) & 1u) != 0, hit)
+            << "lane " << i << ": " << describe(block.lanes().ray(i));
+        if (hit) {
+          ++hitCount;
+          EXPECT_TRUE(identical(hits.hit[i], h)) << "lane " << i << ": " << describe(block.lanes().ray(i));
+        }
+      }
+    }
+    EXPECT_GT(hitCount, 50);
+  }
+}
+
 TEST(PacketTfar, VectorPassesEqualTheScalarLoops) {
   Rng rng(7, 1);
   const float special[] = {kInfinity,

@@ -1,0 +1,268 @@
+// Compiled once per SIMD target by Highway's foreach_target.h; see accel/quadric_lanes.h. Each
+// kernel below is its scalar routine (at the end of the file) with every branch turned into a
+// lane mask, operation for operation.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "accel/quadric_lanes.cpp"
+#include <hwy/foreach_target.h>  // must come before highway.h
+#include <hwy/highway.h>
+
+#include "accel/double_lanes-inl.h"
+#include "accel/quadric_lanes.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace ember::HWY_NAMESPACE {
+
+HWY_INLINE Vec3V64 loadRays(D64 d, const float* const* xyz, unsigned i) {
+  return {loadPromoted(d, xyz[0], i), loadPromoted(d, xyz[1], i), loadPromoted(d, xyz[2], i)};
+}
+HWY_INLINE Vec3V64 splat64(D64 d, const glm::dvec3& v) {
+  return splat64(d, v.x, v.y, v.z);
+}
+HWY_INLINE Vec3V64 sub(const Vec3V64& a, const Vec3V64& b) {
+  return {hn::Sub(a.x, b.x), hn::Sub(a.y, b.y), hn::Sub(a.z, b.z)};
+}
+// a + t b, per component.
+HWY_INLINE Vec3V64 along(const Vec3V64& a, const V64& t, const Vec3V64& b) {
+  return {hn::Add(a.x, hn::Mul(t, b.x)), hn::Add(a.y, hn::Mul(t, b.y)), hn::Add(a.z, hn::Mul(t, b.z))};
+}
+
+uint32_t DiscCrossingsKernel(const RayLanes& rays, const ExactDisc& disc, const float* tMaxLanes,
+                             uint32_t lanes, DiscLanes& out) {
+  const D64 d;
+  const unsigned step = unsigned(hn::Lanes(d));
+  const Vec3V64 center = splat64(d, disc.center), n = splat64(d, disc.n), s = splat64(d, disc.s),
+                t = splat64(d, disc.t);
+  const V64 zero = hn::Zero(d), r2 = hn::Set(d, disc.radius * disc.radius);
+  uint32_t hits = 0;
+  for (unsigned i = 0; i < rays.n; i += step) {
+    const M64 live = blockMask(d, lanes, i);
+    if (hn::AllFalse(d, live)) continue;
+    const Vec3V64 o = loadRays(d, rays.org, i), dir = loadRays(d, rays.dir, i);
+    const V64 denom = dot64(dir, n);
+    const V64 tHit = hn::Div(dot64(sub(center, o), n), denom);
+    const M64 outside = outsideInterval(tHit, loadPromoted(d, rays.tnear, i), loadPromoted(d, tMaxLanes, i));
+    const Vec3V64 rel = sub(along(o, tHit, dir), center);
+    const V64 x = dot64(rel, s), y = dot64(rel, t);
+    const M64 beyondRim = hn::Gt(hn::Add(hn::Mul(x, x), hn::Mul(y, y)), r2);
+    const M64 hit = hn::AndNot(hn::Or(hn::Eq(denom, zero), hn::Or(outside, beyondRim)), live);
+    hn::StoreU(tHit, d, out.t + i);
+    hn::StoreU(x, d, out.x + i);
+    hn::StoreU(y, d, out.y + i);
+    hits |= blockBits(d, hit, i);
+  }
+  return hits;
+}
+
+uint32_t LateralRootsKernel(const RayLanes& rays, const LateralQuadric& quadric, uint32_t lanes,
+                            LateralLanes& out) {
+  const D64 d;
+  const unsigned step = unsigned(hn::Lanes(d));
+  const Vec3V64 base = splat64(d, quadric.base), s = splat64(d, quadric.s), t = splat64(d, quadric.t),
+                n = splat64(d, quadric.n);
+  const V64 zero = hn::Zero(d), two = hn::Set(d, 2.0), h = hn::Set(d, quadric.height),
+            r2 = hn::Set(d, quadric.r2), k2 = hn::Set(d, quadric.k2);
+  uint32_t hits = 0;
+  for (unsigned i = 0; i < rays.n; i += step) {
+    const M64 live = blockMask(d, lanes, i);
+    if (hn::AllFalse(d, live)) continue;
+    const Vec3V64 rel = sub(loadRays(d, rays.org, i), base), dir = loadRays(d, rays.dir, i);
+    const V64 ox = dot64(rel, s), oy = dot64(rel, t), oz = dot64(rel, n);
+    const V64 dx = dot64(dir, s), dy = dot64(dir, t), dz = dot64(dir, n);
+    const V64 radial = hn::Add(hn::Mul(dx, dx), hn::Mul(dy, dy));
+    const V64 crossed = hn::Add(hn::Mul(ox, dx), hn::Mul(oy, dy));
+    const V64 spread = hn::Add(hn::Mul(ox, ox), hn::Mul(oy, oy));
+    V64 a, b, c;
+    M64 solvable;
+    if (quadric.cone) {
+      const V64 hz = hn::Sub(h, oz);
+      a = hn::Sub(radial, hn::Mul(hn::Mul(k2, dz), dz));
+      b = hn::Mul(two, hn::Add(crossed, hn::Mul(hn::Mul(k2, hz), dz)));
+      c = hn::Sub(spread, hn::Mul(hn::Mul(k2, hz), hz));
+      solvable = live;
+    } else {
+      a = radial;
+      b = hn::Mul(two, crossed);
+      c = hn::Sub(spread, r2);
+      solvable = hn::And(live, hn::Gt(a, zero));
+    }
+    const QuadraticRoots roots = solveQuadraticLanes(d, a, b, c);
+    const V64 tMin = loadPromoted(d, rays.tnear, i), tMax = loadPromoted(d, rays.tfar, i);
+    // A root counts within the interval and between the base (z = 0) and the top (z = h).
+    const auto usable = [&](const V64& root) {
+      const V64 z = hn::Add(oz, hn::Mul(root, dz));
+      return hn::Not(hn::Or(outsideInterval(root, tMin, tMax), hn::Or(hn::Lt(z, zero), hn::Gt(z, h))));
+    };
+    const M64 first = usable(roots.t0);
+    const V64 root = hn::IfThenElse(first, roots.t0, roots.t1);
+    const M64 hit = hn::And(hn::And(solvable, roots.real), hn::Or(first, usable(roots.t1)));
+    hn::StoreU(root, d, out.t + i);
+    hn::StoreU(hn::Add(ox, hn::Mul(root, dx)), d, out.x + i);
+    hn::StoreU(hn::Add(oy, hn::Mul(root, dy)), d, out.y + i);
+    hn::StoreU(hn::Add(oz, hn::Mul(root, dz)), d, out.z + i);
+    hits |= blockBits(d, hit, i);
+  }
+  return hits;
+}
+
+uint32_t BoxCrossingsKernel(const RayLanes& rays, const ExactBox& box, uint32_t lanes, BoxLanes& out) {
+  const D64 d;
+  const unsigned step = unsigned(hn::Lanes(d));
+  const Vec3V64 center = splat64(d, box.center);
+  const Vec3V64 axes[3] = {splat64(d, box.axes[0]), splat64(d, box.axes[1]), splat64(d, box.axes[2])};
+  const V64 zero = hn::Zero(d), infinity = hn::Set(d, double(kInfinity));
+  uint32_t hits = 0;
+  for (unsigned i = 0; i < rays.n; i += step) {
+    const M64 live = blockMask(d, lanes, i);
+    if (hn::AllFalse(d, live)) continue;
+    const Vec3V64 rel = sub(loadRays(d, rays.org, i), center), dir = loadRays(d, rays.dir, i);
+    V64 tNear = hn::Neg(infinity), tFar = infinity;
+    V64 nearAxis = hn::Set(d, -1.0), farAxis = nearAxis;
+    M64 parallelOutside = hn::FirstN(d, 0);
+    V64 o[3], dl[3];
+    for (int k = 0; k < 3; ++k) {
+      o[k] = dot64(axes[k], rel);
+      dl[k] = dot64(axes[k], dir);
+      const V64 half = hn::Set(d, box.half[k]);
+      const M64 parallel = hn::Eq(dl[k], zero);
+      parallelOutside = hn::Or(parallelOutside, hn::And(parallel, hn::Gt(hn::Abs(o[k]), half)));
+      V64 t0 = hn::Div(hn::Sub(hn::Neg(half), o[k]), dl[k]);
+      V64 t1 = hn::Div(hn::Sub(half, o[k]), dl[k]);
+      const M64 swap = hn::Gt(t0, t1);
+      const V64 lo = hn::IfThenElse(swap, t1, t0), hi = hn::IfThenElse(swap, t0, t1);
+      t0 = lo;
+      t1 = hi;
+      const V64 axis = hn::Set(d, double(k));
+      const M64 nearer = hn::AndNot(parallel, hn::Gt(t0, tNear));
+      tNear = hn::IfThenElse(nearer, t0, tNear);
+      nearAxis = hn::IfThenElse(nearer, axis, nearAxis);
+      const M64 farther = hn::AndNot(parallel, hn::Lt(t1, tFar));
+      tFar = hn::IfThenElse(farther, t1, tFar);
+      farAxis = hn::IfThenElse(farther, axis, farAxis);
+    }
+    const V64 tMin = loadPromoted(d, rays.tnear, i), tMax = loadPromoted(d, rays.tfar, i);
+    const auto within = [&](const V64& t) { return hn::And(hn::Gt(t, tMin), hn::Lt(t, tMax)); };
+    const M64 entry = within(tNear);
+    const V64 t = hn::IfThenElse(entry, tNear, tFar);
+    const V64 axis = hn::IfThenElse(entry, nearAxis, farAxis);
+    const M64 crossed = hn::And(hn::Not(hn::Gt(tNear, tFar)), hn::Or(entry, within(tFar)));
+    const M64 hit = hn::AndNot(parallelOutside, hn::And(live, hn::And(crossed, hn::Not(hn::Lt(axis, zero)))));
+    hn::StoreU(t, d, out.t + i);
+    for (int k = 0; k < 3; ++k) hn::StoreU(hn::Add(o[k], hn::Mul(t, dl[k])), d, out.local[k] + i);
+    hn::StoreU(axis, d, out.axis + i);
+    hits |= blockBits(d, hit, i);
+  }
+  return hits;
+}
+
+}  // namespace ember::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+#include "accel/solve.h"
+
+namespace ember {
+
+HWY_EXPORT(DiscCrossingsKernel);
+HWY_EXPORT(LateralRootsKernel);
+HWY_EXPORT(BoxCrossingsKernel);
+
+bool ExactDisc::cross(const Ray& ray, float tMin, float tMax, DiscCrossing& out) const {
+  const glm::dvec3 o(ray.origin), dir(ray.dir);
+  const double denom = glm::dot(dir, n);
+  if (denom == 0.0) return false;  // parallel: a zero-thickness disc is never hit edge-on
+  const double tHit = glm::dot(center - o, n) / denom;
+  if (tHit <= tMin || tHit >= tMax) return false;
+  const glm::dvec3 rel = o + tHit * dir - center;
+  const double x = glm::dot(rel, s), y = glm::dot(rel, t);
+  if (x * x + y * y > radius * radius) return false;
+  out = {tHit, x, y};
+  return true;
+}
+
+bool LateralQuadric::nearestRoot(const Ray& ray, float tMin, float tMax, LateralRoot& out) const {
+  const glm::dvec3 rel = glm::dvec3(ray.origin) - base, dir(ray.dir);
+  const double ox = glm::dot(rel, s), oy = glm::dot(rel, t), oz = glm::dot(rel, n);
+  const double dx = glm::dot(dir, s), dy = glm::dot(dir, t), dz = glm::dot(dir, n);
+  double a, b, c;
+  if (cone) {
+    const double hz = height - oz;
+    a = dx * dx + dy * dy - k2 * dz * dz;
+    b = 2.0 * (ox * dx + oy * dy + k2 * hz * dz);
+    c = ox * ox + oy * oy - k2 * hz * hz;
+  } else {
+    a = dx * dx + dy * dy;
+    if (!(a > 0.0)) return false;  // along the axis: the ray never meets the side
+    b = 2.0 * (ox * dx + oy * dy);
+    c = ox * ox + oy * oy - r2;
+  }
+  double roots[2];
+  if (!solveQuadratic(a, b, c, roots[0], roots[1])) return false;
+  for (double root : roots) {
+    if (root <= tMin || root >= tMax) continue;
+    const double z = oz + root * dz;
+    if (z < 0.0 || z > height) continue;  // also rejects a cone's mirror-image nappe above the apex
+    out = {root, ox + root * dx, oy + root * dy, z};
+    return true;
+  }
+  return false;
+}
+
+bool ExactBox::cross(const Ray& ray, float tMin, float tMax, BoxCrossing& out) const {
+  const glm::dvec3 rel = glm::dvec3(ray.origin) - center, dir(ray.dir);
+  double tNear = -double(kInfinity), tFar = double(kInfinity);
+  int nearAxis = -1, farAxis = -1;
+  glm::dvec3 o, dl;
+  for (int k = 0; k < 3; ++k) {
+    o[k] = glm::dot(axes[k], rel);
+    dl[k] = glm::dot(axes[k], dir);
+  }
+  for (int k = 0; k < 3; ++k) {
+    if (dl[k] == 0.0) {
+      if (std::abs(o[k]) > half[k]) return false;
+      continue;
+    }
+    double t0 = (-half[k] - o[k]) / dl[k];
+    double t1 = (half[k] - o[k]) / dl[k];
+    if (t0 > t1) std::swap(t0, t1);
+    if (t0 > tNear) {
+      tNear = t0;
+      nearAxis = k;
+    }
+    if (t1 < tFar) {
+      tFar = t1;
+      farAxis = k;
+    }
+  }
+  if (tNear > tFar) return false;
+  double t;
+  int axis;
+  if (tNear > tMin && tNear < tMax) {
+    t = tNear;
+    axis = nearAxis;
+  } else if (tFar > tMin && tFar < tMax) {
+    t = tFar;  // the ray starts inside the box
+    axis = farAxis;
+  } else {
+    return false;
+  }
+  if (axis < 0) return false;
+  out = {t, o + t * dl, axis};
+  return true;
+}
+
+uint32_t discCrossings(const RayLanes& rays, const ExactDisc& disc, const float* tMax, uint32_t lanes,
+                       DiscLanes& out) {
+  return HWY_DYNAMIC_DISPATCH(DiscCrossingsKernel)(rays, disc, tMax, lanes, out);
+}
+
+uint32_t lateralRoots(const RayLanes& rays, const LateralQuadric& quadric, uint32_t lanes,
+                      LateralLanes& out) {
+  return HWY_DYNAMIC_DISPATCH(LateralRootsKernel)(rays, quadric, lanes, out);
+}
+
+uint32_t boxCrossings(const RayLanes& rays, const ExactBox& box, uint32_t lanes, BoxLanes& out) {
+  return HWY_DYNAMIC_DISPATCH(BoxCrossingsKernel)(rays, box, lanes, out);
+}
+
+}  // namespace ember
+#endif

@@ -1,0 +1,86 @@
+// The exact intersection routines of the disc, the cylinder's and cone's lateral surfaces and the
+// box, each in two forms computed by the same double-precision operations in the same order: a
+// scalar one for a single ray (Shape::intersect) and a Highway kernel for a block of packet lanes
+// at once (Shape::intersectLanes, the route of every ray Embree traces). IEEE arithmetic rounds
+// the same in a vector lane as in a scalar register, and this file's implementation is compiled
+// without fused multiply-adds, so each lane's result equals the scalar routine's bit for bit
+// (tests/test_shape_lanes.cpp). The shapes build their LocalHit from these results with one
+// shared scalar function, so the hits the two routes report are identical too. Unlike the
+// sphere's and the flat shapes' kernels, no float filter runs first: a ray reaching one of these
+// shapes' bounding boxes usually hits it.
+#pragma once
+
+#include "accel/shape_lanes.h"
+#include "core/math.h"
+
+#include <cstdint>
+
+namespace ember {
+
+// A disc's plane crossing within (tMin, tMax) and inside its radius (DiscGeometry::intersect): t
+// and the crossing's coordinates in the disc's frame.
+struct DiscCrossing {
+  double t, x, y;
+};
+struct ExactDisc {
+  glm::dvec3 center{0.0}, n{0.0, 0.0, 1.0}, s{1.0, 0.0, 0.0}, t{0.0, 1.0, 0.0};
+  double radius = 0.0;
+
+  bool cross(const Ray& ray, float tMin, float tMax, DiscCrossing& out) const;
+};
+struct DiscLanes {
+  alignas(64) double t[RayLanes::kMaxLanes];
+  alignas(64) double x[RayLanes::kMaxLanes];
+  alignas(64) double y[RayLanes::kMaxLanes];
+};
+// ExactDisc::cross for the lanes in `lanes`, lane i's interval being (rays.tnear[i], tMax[i]):
+// a cap must be nearer than the lateral hit found before it. tMax has kMaxLanes entries. Bit i
+// of the result is set where lane i crosses, with its crossing in lane i of `out`.
+uint32_t discCrossings(const RayLanes& rays, const ExactDisc& disc, const float* tMax, uint32_t lanes,
+                       DiscLanes& out);
+
+// The lateral surface of a cylinder, x^2 + y^2 = r^2, or of a cone, x^2 + y^2 = k^2 (h - z)^2,
+// for 0 <= z <= h in the frame (s, t, n) at the base's centre; its nearer root within (tMin,
+// tMax), solved in double with the numerically stable quadratic (accel/solve.h).
+struct LateralRoot {
+  double t, x, y, z;
+};
+struct LateralQuadric {
+  glm::dvec3 base{0.0}, s{1.0, 0.0, 0.0}, t{0.0, 1.0, 0.0}, n{0.0, 0.0, 1.0};
+  double height = 0.0;
+  bool cone = false;
+  double r2 = 0.0;  // the cylinder's radius^2
+  double k2 = 0.0;  // the cone's (radius / height)^2
+
+  bool nearestRoot(const Ray& ray, float tMin, float tMax, LateralRoot& out) const;
+};
+struct LateralLanes {
+  alignas(64) double t[RayLanes::kMaxLanes];
+  alignas(64) double x[RayLanes::kMaxLanes];
+  alignas(64) double y[RayLanes::kMaxLanes];
+  alignas(64) double z[RayLanes::kMaxLanes];
+};
+uint32_t lateralRoots(const RayLanes& rays, const LateralQuadric& quadric, uint32_t lanes, LateralLanes& out);
+
+// The box's slab test in its own frame (Kay & Kajiya 1986): the entry within (tMin, tMax), else
+// the exit (a ray starting inside), with the point in box coordinates and the axis of its face.
+struct BoxCrossing {
+  double t;
+  glm::dvec3 local;
+  int axis;
+};
+struct ExactBox {
+  glm::dvec3 center{0.0};
+  glm::dvec3 axes[3]{{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};  // the rotation's columns
+  glm::dvec3 half{0.0};
+
+  bool cross(const Ray& ray, float tMin, float tMax, BoxCrossing& out) const;
+};
+struct BoxLanes {
+  alignas(64) double t[RayLanes::kMaxLanes];
+  alignas(64) double local[3][RayLanes::kMaxLanes];
+  alignas(64) double axis[RayLanes::kMaxLanes];  // 0, 1 or 2 where the lane crosses
+};
+uint32_t boxCrossings(const RayLanes& rays, const ExactBox& box, uint32_t lanes, BoxLanes& out);
+
+}  // namespace ember
