@@ -159,6 +159,7 @@ Quad::Quad(const std::array<Vec3, 4>& v, const std::array<Vec2, 4>& uv)
   sampling_ = QuadSampling::of(corners, rectangle_, normal_, area0_, area1_);
   if (singleFilter_) {
     filters_[0] = filters_[1] = TriangleFilter::of(v[0], v[1], v[3], planes_[0], true);
+    axisAligned_ = AxisRectangleFilter::of(v[0], v[1], v[2], v[3], axisFilter_);
     coords_[0] = coords_[1] = PlaneCoordinates::of(v[0], v[1], v[3]);
   } else {
     filters_[0] = TriangleFilter::of(v[0], v[1], v[2], planes_[0]);
@@ -222,6 +223,10 @@ Vec2 Quad::parallelogramUv(Vec2 b) const {
 void Quad::halfLanes(int half, const RayLanes& rays, TriangleLanes& out) const {
   if (!((half == 0 ? area0_ : area1_) > 0.0f)) {
     out.candidates = out.inside = 0;
+    return;
+  }
+  if (axisAligned_) {
+    axisRectangleLanes(rays, axisFilter_, out);
     return;
   }
   triangleLanes(rays, filters_[half], out);

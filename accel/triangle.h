@@ -83,6 +83,8 @@ class Quad final : public Shape {
   TriangleFilter filters_[2];   // of the same halves, or twice the one of the whole parallelogram
   PlaneCoordinates coords_[2];  // likewise
   bool singleFilter_ = false;
+  bool axisAligned_ = false;  // a single filter's parallelogram is an axis-aligned rectangle
+  AxisRectangleFilter axisFilter_;
   float area0_, area1_;    // of (v0,v1,v2) and (v0,v2,v3)
   QuadSampling sampling_;  // what the light-sampling kernel needs
 };

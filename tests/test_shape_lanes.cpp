@@ -212,6 +212,18 @@ std::vector<ShapeCase> cases(const Vec3& at, float s) {
                                                  at + s * Vec3(1, 0, 1), at + s * Vec3(-1, 0, 1)},
                              quadUv),
       true);
+  // The same facing -x, its edges given along z first (the axis-rectangle filter's other order).
+  add("axis quad facing -x",
+      std::make_unique<Quad>(std::array<Vec3, 4>{at + s * Vec3(0, -1, -1), at + s * Vec3(0, -1, 1),
+                                                 at + s * Vec3(0, 1, 1), at + s * Vec3(0, 1, -1)},
+                             quadUv),
+      true);
+  add("flipped axis quad",
+      std::make_unique<FlippedShape>(
+          std::make_unique<Quad>(std::array<Vec3, 4>{at + s * Vec3(-1, -0.5f, 0), at + s * Vec3(1, -0.5f, 0),
+                                                     at + s * Vec3(1, 0.5f, 0), at + s * Vec3(-1, 0.5f, 0)},
+                                 quadUv)),
+      true);
   // A rotated rectangle (its fourth vertex rounds off the parallelogram), a skewed planar quad
   // and one whose fourth vertex lifts it 1e-4 out of plane: two filters each.
   const Vec3 u = glm::normalize(Vec3(0.8f, 0.3f, -0.2f)),
@@ -324,6 +336,36 @@ std::vector<std::pair<std::string, RayMaker>> families(const Shape& shape, float
                    const Vec3 o = target + size * (0.1f + rng.uniform()) * randomDirection(rng);
                    return Ray{o, glm::normalize(target - o), rng.uniform() < 0.5f ? kInfinity : 2.0f * size};
                  }});
+  // Across the rim, found by bisection: from a fixed origin, rays aimed along a line in the tangent
+  // plane of a surface point are hit at the point and missed far along the line; between the two,
+  // 40 halvings find where the scalar routine's verdict flips (an edge, a cap's rim or a curved
+  // shape's silhouette), and the ray is aimed within 1e-9 to 1e-4 of the shape's size of it, on
+  // either side. There a filter's rounding decides, so a bound too tight shows.
+  out.push_back({"across the rim", [&shape, size](Rng& rng) {
+                   const ShapeSample s = shape.sampleArea(next2(rng));
+                   const Vec3 o = s.p + size * (0.05f + 3.0f * rng.uniform()) * randomDirection(rng);
+                   Vec3 along = randomDirection(rng);
+                   along -= glm::dot(along, s.n) * s.n;
+                   const Ray atPoint{o, glm::normalize(s.p - o)};
+                   if (!(glm::length(along) > 1e-3f)) return atPoint;
+                   along = glm::normalize(along);
+                   const auto aimed = [&](float lambda) {
+                     return Ray{o, glm::normalize(s.p + lambda * along - o)};
+                   };
+                   const auto hits = [&](float lambda) {
+                     LocalHit h;
+                     return shape.intersect(aimed(lambda), 0.0f, kInfinity, h);
+                   };
+                   float in = 0.0f, out = 4.0f * size;
+                   if (!hits(in) || hits(out)) return atPoint;  // no single crossing of the rim on this line
+                   for (int k = 0; k < 40; ++k) {
+                     const float mid = 0.5f * (in + out);
+                     if (mid == in || mid == out) break;
+                     (hits(mid) ? in : out) = mid;
+                   }
+                   const float offset = size * std::pow(10.0f, -9.0f + 5.0f * rng.uniform());
+                   return aimed(rng.uniform() < 0.5f ? in - offset : out + offset);
+                 }});
   return out;
 }
 
@@ -416,6 +458,68 @@ TEST(ShapeLanes, KernelSettlesHitsAwayFromEdges) {
       EXPECT_GE(settled, rays * 95 / 100) << settled << " of " << rays << " settled";
     }
   }
+}
+
+// The axis-aligned rectangle's filter must settle those hits as well, and is built only for quads
+// that are exactly such rectangles.
+TEST(ShapeLanes, AxisRectangleKernelSettlesHitsAwayFromEdges) {
+  for (const auto& [at, size] : {std::pair{Vec3(0.0f), 1.0f}, std::pair{Vec3(6e3f, -3.5e3f, 1.1e4f), 2.0f}}) {
+    for (int axis = 0; axis < 3; ++axis) {
+      SCOPED_TRACE("axis " + std::to_string(axis) + " at " + std::to_string(at.x));
+      Vec3 e1(0.0f), e2(0.0f);
+      e1[(axis + 1) % 3] = 2.0f * size;
+      e2[(axis + 2) % 3] = 1.5f * size;
+      const Vec3 v0 = at, v1 = at + e1, v3 = at + e2, v2 = v1 + e2;
+      AxisRectangleFilter filter;
+      ASSERT_TRUE(AxisRectangleFilter::of(v0, v1, v2, v3, filter));
+      EXPECT_EQ(filter.axis, axis);
+      Vec3 n(0.0f);
+      n[axis] = 1.0f;
+      Rng rng(11, unsigned(axis));
+      int rays = 0, settled = 0;
+      for (int b = 0; b < 200; ++b) {
+        Block block;
+        for (unsigned i = 0; i < RayLanes::kMaxLanes; ++i) {
+          const float b1 = 0.05f + 0.9f * rng.uniform(), b2 = 0.05f + 0.9f * rng.uniform();
+          const Vec3 target = v0 + b1 * (v1 - v0) + b2 * (v3 - v0);
+          Vec3 w = randomDirection(rng);
+          if (std::abs(glm::dot(w, n)) < 0.1f) w = glm::normalize(w + 0.2f * n);
+          const Vec3 o = target + size * (1.0f + 2.0f * rng.uniform()) * w;
+          block.set(i, Ray{o, glm::normalize(target - o)}, true);
+        }
+        TriangleLanes lanes;
+        axisRectangleLanes(block.lanes(), filter, lanes);
+        rays += int(RayLanes::kMaxLanes);
+        settled += __builtin_popcount(lanes.inside);
+      }
+      EXPECT_GE(settled, rays * 95 / 100) << settled << " of " << rays << " settled";
+    }
+  }
+}
+
+TEST(ShapeLanes, AxisRectangleFilterOnlyForExactAxisRectangles) {
+  const Vec3 v0(1.0f, 2.0f, 3.0f), v1(1.0f, 2.0f, 5.0f), v3(1.0f, -1.0f, 3.0f), v2(1.0f, -1.0f, 5.0f);
+  AxisRectangleFilter f;
+  ASSERT_TRUE(AxisRectangleFilter::of(v0, v1, v2, v3, f));
+  EXPECT_EQ(f.axis, 0);
+  EXPECT_EQ(f.across[0], 2);  // v1 - v0 runs along z
+  EXPECT_EQ(f.across[1], 1);
+  EXPECT_EQ(f.c, 1.0f);
+  EXPECT_EQ(f.lo[0], 3.0f);
+  EXPECT_EQ(f.hi[0], 5.0f);
+  EXPECT_EQ(f.lo[1], -1.0f);
+  EXPECT_EQ(f.hi[1], 2.0f);
+  EXPECT_EQ(f.boundsMax, 5.0f);
+  // One corner off the plane, or off the parallelogram, by an ulp; an edge along no axis; an
+  // edge of zero length; a NaN or infinite corner.
+  const float up = std::nextafter(1.0f, 2.0f);
+  EXPECT_FALSE(AxisRectangleFilter::of(v0, v1, Vec3(up, -1.0f, 5.0f), v3, f));
+  EXPECT_FALSE(AxisRectangleFilter::of(v0, v1, Vec3(1.0f, -1.0f, std::nextafter(5.0f, 6.0f)), v3, f));
+  EXPECT_FALSE(AxisRectangleFilter::of(v0, Vec3(1.0f, 3.0f, 5.0f), Vec3(1.0f, 0.0f, 5.0f), v3, f));
+  EXPECT_FALSE(AxisRectangleFilter::of(v0, v0, v3, v3, f));
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  EXPECT_FALSE(AxisRectangleFilter::of(v0, Vec3(1.0f, 2.0f, nan), Vec3(1.0f, -1.0f, nan), v3, f));
+  EXPECT_FALSE(AxisRectangleFilter::of(v0, Vec3(1.0f, 2.0f, inf), Vec3(1.0f, -1.0f, inf), v3, f));
 }
 
 }  // namespace
