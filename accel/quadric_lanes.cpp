@@ -154,17 +154,50 @@ uint32_t BoxCrossingsKernel(const RayLanes& rays, const ExactBox& box, uint32_t 
   return hits;
 }
 
+uint32_t AxisRectangleCrossingsKernel(const RayLanes& rays, const ExactAxisRectangle& rect, uint32_t lanes,
+                                      RectangleLanes& out) {
+  const D64 d;
+  const unsigned step = unsigned(hn::Lanes(d));
+  const unsigned k = unsigned(rect.axis), ia = unsigned(rect.across[0]), ib = unsigned(rect.across[1]);
+  const V64 c = hn::Set(d, rect.c), zero = hn::Zero(d);
+  const V64 loA = hn::Set(d, rect.lo[0]), hiA = hn::Set(d, rect.hi[0]);
+  const V64 loB = hn::Set(d, rect.lo[1]), hiB = hn::Set(d, rect.hi[1]);
+  uint32_t hits = 0;
+  for (unsigned i = 0; i < rays.n; i += step) {
+    const M64 live = blockMask(d, lanes, i);
+    if (hn::AllFalse(d, live)) continue;
+    const V64 denom = loadPromoted(d, rays.dir[k], i);
+    const V64 tHit = hn::Div(hn::Sub(c, loadPromoted(d, rays.org[k], i)), denom);
+    const M64 within =
+        hn::And(hn::Gt(tHit, loadPromoted(d, rays.tnear, i)), hn::Lt(tHit, loadPromoted(d, rays.tfar, i)));
+    const V64 a = hn::Add(loadPromoted(d, rays.org[ia], i), hn::Mul(tHit, loadPromoted(d, rays.dir[ia], i)));
+    const V64 b = hn::Add(loadPromoted(d, rays.org[ib], i), hn::Mul(tHit, loadPromoted(d, rays.dir[ib], i)));
+    const M64 inside =
+        hn::And(hn::And(hn::Ge(a, loA), hn::Le(a, hiA)), hn::And(hn::Ge(b, loB), hn::Le(b, hiB)));
+    const M64 hit = hn::And(hn::And(live, hn::Ne(denom, zero)), hn::And(within, inside));
+    hn::StoreU(tHit, d, out.t + i);
+    hn::StoreU(a, d, out.a + i);
+    hn::StoreU(b, d, out.b + i);
+    hits |= blockBits(d, hit, i);
+  }
+  return hits;
+}
+
 }  // namespace ember::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
 #include "accel/solve.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace ember {
 
 HWY_EXPORT(DiscCrossingsKernel);
 HWY_EXPORT(LateralRootsKernel);
 HWY_EXPORT(BoxCrossingsKernel);
+HWY_EXPORT(AxisRectangleCrossingsKernel);
 
 bool ExactDisc::cross(const Ray& ray, float tMin, float tMax, DiscCrossing& out) const {
   const glm::dvec3 o(ray.origin), dir(ray.dir);
@@ -248,6 +281,63 @@ bool ExactBox::cross(const Ray& ray, float tMin, float tMax, BoxCrossing& out) c
   if (axis < 0) return false;
   out = {t, o + t * dl, axis};
   return true;
+}
+
+bool ExactAxisRectangle::of(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Vec3& v3,
+                            ExactAxisRectangle& out) {
+  const Vec3 e1 = v1 - v0, e2 = v3 - v0;
+  for (int k = 0; k < 3; ++k) {
+    if (!(v0[k] == v1[k] && v0[k] == v2[k] && v0[k] == v3[k])) continue;
+    const int p = (k + 1) % 3, q = (k + 2) % 3;
+    int first;  // the axis v1 - v0 runs along
+    if (e1[p] != 0.0f && e1[q] == 0.0f && e2[p] == 0.0f && e2[q] != 0.0f) {
+      first = p;
+    } else if (e1[q] != 0.0f && e1[p] == 0.0f && e2[q] == 0.0f && e2[p] != 0.0f) {
+      first = q;
+    } else {
+      return false;
+    }
+    const int second = first == p ? q : p;
+    // Double adds these floats without rounding: v2 closes the parallelogram exactly.
+    if (glm::dvec3(v1) + glm::dvec3(v3) - glm::dvec3(v0) != glm::dvec3(v2)) return false;
+    ExactAxisRectangle r;
+    r.axis = k;
+    r.across[0] = first;
+    r.across[1] = second;
+    r.c = double(v0[k]);
+    r.corner[0] = double(v0[first]);
+    r.corner[1] = double(v0[second]);
+    r.edge[0] = double(v1[first]) - double(v0[first]);
+    r.edge[1] = double(v3[second]) - double(v0[second]);
+    const double ends[2][2] = {{double(v0[first]), double(v1[first])},
+                               {double(v0[second]), double(v3[second])}};
+    for (int j = 0; j < 2; ++j) {
+      r.lo[j] = std::min(ends[j][0], ends[j][1]);
+      r.hi[j] = std::max(ends[j][0], ends[j][1]);
+      if (!std::isfinite(r.edge[j]) || !std::isfinite(r.lo[j]) || !std::isfinite(r.hi[j])) return false;
+    }
+    if (!std::isfinite(r.c)) return false;
+    out = r;
+    return true;
+  }
+  return false;
+}
+
+bool ExactAxisRectangle::cross(const Ray& ray, float tMin, float tMax, RectangleCrossing& out) const {
+  const double denom = double(ray.dir[axis]);
+  if (denom == 0.0) return false;  // parallel: a zero-thickness rectangle is never hit edge-on
+  const double tHit = (c - double(ray.origin[axis])) / denom;
+  if (!(tHit > tMin && tHit < tMax)) return false;
+  const double a = double(ray.origin[across[0]]) + tHit * double(ray.dir[across[0]]);
+  const double b = double(ray.origin[across[1]]) + tHit * double(ray.dir[across[1]]);
+  if (!(a >= lo[0] && a <= hi[0] && b >= lo[1] && b <= hi[1])) return false;
+  out = {tHit, a, b};
+  return true;
+}
+
+uint32_t axisRectangleCrossings(const RayLanes& rays, const ExactAxisRectangle& rect, uint32_t lanes,
+                                RectangleLanes& out) {
+  return HWY_DYNAMIC_DISPATCH(AxisRectangleCrossingsKernel)(rays, rect, lanes, out);
 }
 
 uint32_t discCrossings(const RayLanes& rays, const ExactDisc& disc, const float* tMax, uint32_t lanes,

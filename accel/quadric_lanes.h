@@ -1,13 +1,12 @@
-// The exact intersection routines of the disc, the cylinder's and cone's lateral surfaces and the
-// box, each in two forms computed by the same double-precision operations in the same order: a
-// scalar one for a single ray (Shape::intersect) and a Highway kernel for a block of packet lanes
-// at once (Shape::intersectLanes, the route of every ray Embree traces). IEEE arithmetic rounds
-// the same in a vector lane as in a scalar register, and this file's implementation is compiled
-// without fused multiply-adds, so each lane's result equals the scalar routine's bit for bit
-// (tests/test_shape_lanes.cpp). The shapes build their LocalHit from these results with one
-// shared scalar function, so the hits the two routes report are identical too. Unlike the
-// sphere's and the flat shapes' kernels, no float filter runs first: a ray reaching one of these
-// shapes' bounding boxes usually hits it.
+// The exact intersection routines of the disc, the cylinder's and cone's lateral surfaces, the
+// box and the axis-aligned rectangle, each in two forms computed by the same double-precision operations in
+// the same order: a scalar one for a single ray (Shape::intersect) and a Highway kernel for a block of packet
+// lanes at once (Shape::intersectLanes, the route of every ray Embree traces). IEEE arithmetic rounds the
+// same in a vector lane as in a scalar register, and this file's implementation is compiled without fused
+// multiply-adds, so each lane's result equals the scalar routine's bit for bit (tests/test_shape_lanes.cpp).
+// The shapes build their LocalHit from these results with one shared scalar function, so the hits the two
+// routes report are identical too. Unlike the sphere's and the flat shapes' kernels, no float filter runs
+// first: a ray reaching one of these shapes' bounding boxes usually hits it.
 #pragma once
 
 #include "accel/shape_lanes.h"
@@ -82,5 +81,35 @@ struct BoxLanes {
   alignas(64) double axis[RayLanes::kMaxLanes];  // 0, 1 or 2 where the lane crosses
 };
 uint32_t boxCrossings(const RayLanes& rays, const ExactBox& box, uint32_t lanes, BoxLanes& out);
+
+// An axis-aligned rectangle, the commonest flat shape (walls, floors, area lights): the plane
+// x[axis] = c crossed within (tMin, tMax) at a point whose other two coordinates (along across[0]
+// and across[1]) lie in [lo, hi], bounds included. The plane's denominator is the direction's own
+// component and c - o[axis] is exact in double, so t is a single rounding of the exact quotient;
+// the crossing's coordinates are compared with the rectangle's bounds directly.
+struct RectangleCrossing {
+  double t, a, b;  // the coordinates along across[0] and across[1]
+};
+struct ExactAxisRectangle {
+  int axis = 2;
+  int across[2] = {0, 1};
+  double c = 0.0;
+  double lo[2] = {0.0, 0.0}, hi[2] = {0.0, 0.0};
+  double corner[2] = {0.0, 0.0};  // v0 along across[0], across[1]
+  double edge[2] = {1.0, 1.0};    // v1 - v0 along across[0] and v3 - v0 along across[1], signed
+
+  // The rectangle of the quad with corners v0, v1, v2, v3, if it is one: the corners share one
+  // coordinate bit for bit, the edges v1 - v0 and v3 - v0 each run along one of the other two axes
+  // (non-zero and finite), and v2 = v1 + v3 - v0 exactly.
+  static bool of(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Vec3& v3, ExactAxisRectangle& out);
+  bool cross(const Ray& ray, float tMin, float tMax, RectangleCrossing& out) const;
+};
+struct RectangleLanes {
+  alignas(64) double t[RayLanes::kMaxLanes];
+  alignas(64) double a[RayLanes::kMaxLanes];
+  alignas(64) double b[RayLanes::kMaxLanes];
+};
+uint32_t axisRectangleCrossings(const RayLanes& rays, const ExactAxisRectangle& rect, uint32_t lanes,
+                                RectangleLanes& out);
 
 }  // namespace ember

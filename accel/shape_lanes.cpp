@@ -8,9 +8,6 @@
 #include "accel/shape.h"
 #include "accel/shape_lanes.h"
 
-#include <algorithm>
-#include <cmath>
-
 HWY_BEFORE_NAMESPACE();
 namespace ember::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
@@ -151,52 +148,6 @@ void TriangleLanesKernel(const RayLanes& rays, const TriangleFilter& tri, Triang
   out.inside &= out.candidates;
 }
 
-void AxisRectangleLanesKernel(const RayLanes& rays, const AxisRectangleFilter& rect, TriangleLanes& out) {
-  const D d;
-  const hn::RebindToSigned<D> di;
-  const unsigned k = unsigned(rect.axis), a = unsigned(rect.across[0]), b = unsigned(rect.across[1]);
-  const V c = hn::Set(d, rect.c), zero = hn::Zero(d);
-  const V loA = hn::Set(d, rect.lo[0]), hiA = hn::Set(d, rect.hi[0]);
-  const V loB = hn::Set(d, rect.lo[1]), hiB = hn::Set(d, rect.hi[1]);
-  const V boundsMax = hn::Set(d, rect.boundsMax);
-  const unsigned step = unsigned(hn::Lanes(d));
-  out.candidates = out.inside = 0;
-  for (unsigned i = 0; i < rays.n; i += step) {
-    const M live = hn::RebindMask(d, hn::Eq(hn::LoadU(di, rays.valid + i), hn::Set(di, -1)));
-    if (hn::AllFalse(d, live)) continue;
-    const V dirK = hn::LoadU(d, rays.dir[k] + i);
-    // t = (c - o_k) / dir_k with two roundings, so |t - t*| <= gamma(2) |t*|; the scalar tests'
-    // double-precision t is within 2^-52 of t*. FLT_MIN covers a quotient rounded as a subnormal.
-    const V t = hn::Div(hn::Sub(c, hn::LoadU(d, rays.org[k] + i)), dirK);
-    const V tError = hn::MulAdd(hn::Set(d, gamma(3)), hn::Abs(t), hn::Set(d, 0x1p-126f));
-    // Certain verdicts only where the ray crosses the plane at all (every comparison with NaN is
-    // false, so a NaN direction or an overflowing t leaves the lane to the exact test).
-    const M crosses = hn::Gt(hn::Abs(dirK), zero);
-    const M planeMiss = hn::And(crosses, hn::Or(hn::Le(hn::Add(t, tError), hn::LoadU(d, rays.tnear + i)),
-                                                hn::Ge(hn::Sub(t, tError), hn::LoadU(d, rays.tfar + i))));
-    // The crossing's coordinates o + t dir are off the exact ones by |dir| tError plus the fused
-    // multiply-add's rounding; gamma(2) (|p| + max bound) covers that rounding, the comparisons'
-    // additions and the scalar tests' own double-precision error with room to spare.
-    const V dirA = hn::LoadU(d, rays.dir[a] + i), dirB = hn::LoadU(d, rays.dir[b] + i);
-    const V pA = hn::MulAdd(t, dirA, hn::LoadU(d, rays.org[a] + i));
-    const V pB = hn::MulAdd(t, dirB, hn::LoadU(d, rays.org[b] + i));
-    const V errA =
-        hn::MulAdd(hn::Abs(dirA), tError, hn::Mul(hn::Set(d, gamma(2)), hn::Add(hn::Abs(pA), boundsMax)));
-    const V errB =
-        hn::MulAdd(hn::Abs(dirB), tError, hn::Mul(hn::Set(d, gamma(2)), hn::Add(hn::Abs(pB), boundsMax)));
-    const M outside = hn::Or(hn::Or(hn::Lt(hn::Add(pA, errA), loA), hn::Gt(hn::Sub(pA, errA), hiA)),
-                             hn::Or(hn::Lt(hn::Add(pB, errB), loB), hn::Gt(hn::Sub(pB, errB), hiB)));
-    const M within = hn::And(hn::And(hn::Gt(hn::Sub(pA, errA), loA), hn::Lt(hn::Add(pA, errA), hiA)),
-                             hn::And(hn::Gt(hn::Sub(pB, errB), loB), hn::Lt(hn::Add(pB, errB), hiB)));
-    const M certainMiss = hn::Or(planeMiss, hn::And(crosses, outside));
-    out.candidates |= maskBits(d, hn::AndNot(certainMiss, live)) << i;
-    out.inside |= maskBits(d, hn::And(live, hn::And(crosses, within))) << i;
-  }
-  const uint32_t inRange = rays.n >= 32 ? ~0u : (1u << rays.n) - 1u;
-  out.candidates &= inRange;
-  out.inside &= out.candidates;
-}
-
 uint32_t SphereCandidates(const RayLanes& rays, const Vec3& center, float radius) {
   const D d;
   const Vec3V c = splat(d, center);
@@ -325,7 +276,6 @@ namespace ember {
 
 HWY_EXPORT(RayLanesStep);
 HWY_EXPORT(TriangleLanesKernel);
-HWY_EXPORT(AxisRectangleLanesKernel);
 HWY_EXPORT(SphereCandidates);
 HWY_EXPORT(SphereHitsKernel);
 HWY_EXPORT(PlaneCrossingsKernel);
@@ -362,49 +312,6 @@ unsigned rayLanesStep() {
 
 void triangleLanes(const RayLanes& rays, const TriangleFilter& tri, TriangleLanes& out) {
   HWY_DYNAMIC_DISPATCH(TriangleLanesKernel)(rays, tri, out);
-}
-
-bool AxisRectangleFilter::of(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Vec3& v3,
-                             AxisRectangleFilter& out) {
-  const Vec3 e1 = v1 - v0, e2 = v3 - v0;
-  for (int k = 0; k < 3; ++k) {
-    const int a = (k + 1) % 3, b = (k + 2) % 3;
-    if (!(v0[k] == v1[k] && v0[k] == v2[k] && v0[k] == v3[k])) continue;
-    // Which of the other axes each edge runs along.
-    int alongFirst;
-    if (e1[a] != 0.0f && e1[b] == 0.0f && e2[a] == 0.0f && e2[b] != 0.0f) {
-      alongFirst = a;
-    } else if (e1[b] != 0.0f && e1[a] == 0.0f && e2[b] == 0.0f && e2[a] != 0.0f) {
-      alongFirst = b;
-    } else {
-      return false;
-    }
-    // The fourth corner closes the parallelogram exactly (in double, which adds floats without
-    // rounding here), so the rectangle is [v0, v1] x [v0, v3] along the two axes.
-    const int alongSecond = alongFirst == a ? b : a;
-    if (glm::dvec3(v1) + glm::dvec3(v3) - glm::dvec3(v0) != glm::dvec3(v2)) return false;
-    const float ends[2][2] = {{v0[alongFirst], v1[alongFirst]}, {v0[alongSecond], v3[alongSecond]}};
-    AxisRectangleFilter f;
-    f.axis = k;
-    f.across[0] = alongFirst;
-    f.across[1] = alongSecond;
-    f.c = v0[k];
-    for (int j = 0; j < 2; ++j) {
-      f.lo[j] = std::min(ends[j][0], ends[j][1]);
-      f.hi[j] = std::max(ends[j][0], ends[j][1]);
-      f.boundsMax = std::max({f.boundsMax, std::abs(f.lo[j]), std::abs(f.hi[j])});
-    }
-    if (!std::isfinite(f.boundsMax) || !std::isfinite(f.c) || !std::isfinite(e1[alongFirst]) ||
-        !std::isfinite(e2[alongSecond]))
-      return false;
-    out = f;
-    return true;
-  }
-  return false;
-}
-
-void axisRectangleLanes(const RayLanes& rays, const AxisRectangleFilter& rect, TriangleLanes& out) {
-  HWY_DYNAMIC_DISPATCH(AxisRectangleLanesKernel)(rays, rect, out);
 }
 
 uint32_t sphereCandidates(const RayLanes& rays, const Vec3& center, float radius) {

@@ -82,25 +82,6 @@ unsigned rayLanesStep();
 
 void triangleLanes(const RayLanes& rays, const TriangleFilter& tri, TriangleLanes& out);
 
-// An axis-aligned rectangle as its float filter sees it: the plane x[axis] = c and the bounds
-// [lo, hi] along the other two axes (`across`), all exact floats. The plane's denominator is then
-// the direction's own component, exact, and the crossing point's coordinates need no dual
-// vectors: the test is a third of the general one, for the commonest flat shape there is (walls,
-// floors, area lights). Its verdicts mean what TriangleLanes' do for the whole parallelogram.
-struct AxisRectangleFilter {
-  int axis = 2;
-  int across[2] = {0, 1};
-  float c = 0.0f;
-  float lo[2] = {0.0f, 0.0f}, hi[2] = {0.0f, 0.0f};
-  float boundsMax = 0.0f;  // max |lo|, |hi|
-
-  // The filter of the quad with corners v0, v1, v2, v3, if it is such a rectangle: the corners
-  // share one coordinate bit for bit, the edges v1 - v0 and v3 - v0 each run along one of the
-  // other two axes (both non-zero and finite), and v2 = v1 + v3 - v0 exactly.
-  static bool of(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Vec3& v3, AxisRectangleFilter& out);
-};
-void axisRectangleLanes(const RayLanes& rays, const AxisRectangleFilter& rect, TriangleLanes& out);
-
 // Bit i set: live lane i may hit the sphere (its discriminant may be >= 0).
 uint32_t sphereCandidates(const RayLanes& rays, const Vec3& center, float radius);
 

@@ -6,6 +6,7 @@
 // shapes seen from farther, by area.
 #pragma once
 
+#include "accel/quadric_lanes.h"
 #include "accel/shape.h"
 
 #include <array>
@@ -73,6 +74,8 @@ class Quad final : public Shape {
   bool settledHit(int half, const Ray& ray, float tMin, float tMax, bool needsUv, LocalHit& hit) const;
   // The UV of the point with coordinates b in the single filter's parallelogram (v0, v1, v3).
   Vec2 parallelogramUv(Vec2 b) const;
+  // The hit of an axis-aligned rectangle's crossing, from intersect() and intersectLanes() alike.
+  void rectangleHit(const RectangleCrossing& crossing, bool needsUv, LocalHit& hit) const;
 
   bool rectangle_;
   std::array<Vec3, 4> v_;
@@ -83,8 +86,9 @@ class Quad final : public Shape {
   TriangleFilter filters_[2];   // of the same halves, or twice the one of the whole parallelogram
   PlaneCoordinates coords_[2];  // likewise
   bool singleFilter_ = false;
-  bool axisAligned_ = false;  // a single filter's parallelogram is an axis-aligned rectangle
-  AxisRectangleFilter axisFilter_;
+  // An axis-aligned rectangle is intersected exactly, in one double-precision kernel for a block.
+  bool axisAligned_ = false;
+  ExactAxisRectangle exactRectangle_;
   float area0_, area1_;    // of (v0,v1,v2) and (v0,v2,v3)
   QuadSampling sampling_;  // what the light-sampling kernel needs
 };

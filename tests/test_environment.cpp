@@ -2,12 +2,12 @@
 // and unbiased, and a convex object under a uniform map reflects its albedo.
 #include "accel/sphere.h"
 #include "cli_runner.h"
+#include "core/sampling.h"
 #include "io/image_io.h"
 #include "materials/lambertian.h"
 #include "mc_mean.h"
 #include "renderer/path_integrator.h"
 #include "renderer/render.h"
-#include "core/sampling.h"
 
 #include <gtest/gtest.h>
 
