@@ -298,7 +298,7 @@ bool ExactAxisRectangle::of(const Vec3& v0, const Vec3& v1, const Vec3& v2, cons
       return false;
     }
     const int second = first == p ? q : p;
-    // Double adds these floats without rounding: v2 closes the parallelogram exactly.
+    // Double adds floats of similar magnitude without rounding: v2 closes the parallelogram.
     if (glm::dvec3(v1) + glm::dvec3(v3) - glm::dvec3(v0) != glm::dvec3(v2)) return false;
     ExactAxisRectangle r;
     r.axis = k;

@@ -5,8 +5,8 @@
 // same in a vector lane as in a scalar register, and this file's implementation is compiled without fused
 // multiply-adds, so each lane's result equals the scalar routine's bit for bit (tests/test_shape_lanes.cpp).
 // The shapes build their LocalHit from these results with one shared scalar function, so the hits the two
-// routes report are identical too. Unlike the sphere's and the flat shapes' kernels, no float filter runs
-// first: a ray reaching one of these shapes' bounding boxes usually hits it.
+// routes report are identical too. Unlike the sphere's and the other flat shapes' kernels, no float filter
+// runs first: a ray reaching one of these shapes' bounding boxes usually hits it.
 #pragma once
 
 #include "accel/shape_lanes.h"
@@ -85,7 +85,8 @@ uint32_t boxCrossings(const RayLanes& rays, const ExactBox& box, uint32_t lanes,
 // An axis-aligned rectangle, the commonest flat shape (walls, floors, area lights): the plane
 // x[axis] = c crossed within (tMin, tMax) at a point whose other two coordinates (along across[0]
 // and across[1]) lie in [lo, hi], bounds included. The plane's denominator is the direction's own
-// component and c - o[axis] is exact in double, so t is a single rounding of the exact quotient;
+// component and c - o[axis] is exact in double (unless the two floats' exponents lie more than 29
+// apart), so t is a single rounding of the exact quotient;
 // the crossing's coordinates are compared with the rectangle's bounds directly.
 struct RectangleCrossing {
   double t, a, b;  // the coordinates along across[0] and across[1]

@@ -27,6 +27,7 @@
 #include <cstdint>
 #include <cstring>
 #include <functional>
+#include <iterator>
 #include <limits>
 #include <memory>
 #include <string>
@@ -359,15 +360,17 @@ std::vector<std::pair<std::string, RayMaker>> families(const Shape& shape, float
                      LocalHit h;
                      return shape.intersect(aimed(lambda), 0.0f, kInfinity, h);
                    };
-                   float in = 0.0f, out = 4.0f * size;
-                   if (!hits(in) || hits(out)) return atPoint;  // no single crossing of the rim on this line
+                   float in = 0.0f, beyond = 4.0f * size;
+                   if (!hits(in) || hits(beyond))
+                     return atPoint;  // no single crossing of the rim on this line
                    for (int k = 0; k < 40; ++k) {
-                     const float mid = 0.5f * (in + out);
-                     if (mid == in || mid == out) break;
-                     (hits(mid) ? in : out) = mid;
+                     const float mid = 0.5f * (in + beyond);
+                     if (mid == in || mid == beyond) break;
+                     (hits(mid) ? in : beyond) = mid;
                    }
+                   // Offsets below a float step of lambda leave it the bisection's last hit or first miss.
                    const float offset = size * std::pow(10.0f, -9.0f + 5.0f * rng.uniform());
-                   return aimed(rng.uniform() < 0.5f ? in - offset : out + offset);
+                   return aimed(rng.uniform() < 0.5f ? in - offset : beyond + offset);
                  }});
   return out;
 }
@@ -461,6 +464,61 @@ TEST(ShapeLanes, KernelSettlesHitsAwayFromEdges) {
       EXPECT_GE(settled, rays * 95 / 100) << settled << " of " << rays << " settled";
     }
   }
+}
+
+// The exact rectangle's kernel against its scalar routine on the inputs where a lane mask could
+// diverge from a branch: a zero direction component of either sign, NaN and infinite components,
+// empty and reversed intervals, origins on the plane and exactly on an edge's line.
+TEST(ShapeLanes, ExactAxisRectangleKernelEqualsTheScalarOnSpecialRays) {
+  const Vec3 v0(-1.0f, 0.5f, -0.5f), v1(1.0f, 0.5f, -0.5f), v2(1.0f, 0.5f, 0.5f), v3(-1.0f, 0.5f, 0.5f);
+  ExactAxisRectangle rect;
+  ASSERT_TRUE(ExactAxisRectangle::of(v0, v1, v2, v3, rect));
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  const Ray rays[] = {
+      {Vec3(0.0f, 2.0f, 0.0f), Vec3(0.0f, -1.0f, 0.0f)},        // straight down: a hit
+      {Vec3(0.0f, 2.0f, 0.0f), Vec3(0.3f, 0.0f, 0.1f)},         // parallel, +0
+      {Vec3(0.0f, 2.0f, 0.0f), Vec3(0.3f, -0.0f, 0.1f)},        // parallel, -0
+      {Vec3(0.0f, 0.5f, 0.0f), Vec3(0.3f, -0.0f, 0.1f)},        // in the plane
+      {Vec3(0.0f, 0.5f, 0.0f), Vec3(0.0f, -1.0f, 0.0f)},        // from the plane: t = 0
+      {Vec3(1.0f, 2.0f, 0.0f), Vec3(0.0f, -1.0f, 0.0f)},        // onto an edge's line
+      {Vec3(1.0f, 2.0f, 0.5f), Vec3(0.0f, -1.0f, 0.0f)},        // onto a corner
+      {Vec3(nan, 2.0f, 0.0f), Vec3(0.0f, -1.0f, 0.0f)},         // NaN origin
+      {Vec3(0.0f, 2.0f, 0.0f), Vec3(nan, -1.0f, 0.0f)},         // NaN direction
+      {Vec3(0.0f, 2.0f, 0.0f), Vec3(0.0f, nan, 0.0f)},          // NaN denominator
+      {Vec3(inf, 2.0f, 0.0f), Vec3(0.0f, -1.0f, 0.0f)},         // infinite origin
+      {Vec3(0.0f, 2.0f, 0.0f), Vec3(inf, -1.0f, 0.0f)},         // infinite direction
+      {Vec3(0.0f, 2.0f, 0.0f), Vec3(0.0f, -1e-40f, 0.0f)},      // subnormal denominator
+      {Vec3(0.0f, 2.0f, 0.0f), Vec3(0.0f, -1.0f, 0.0f), 1.5f},  // interval ending at the plane
+      {Vec3(0.0f, 2.0f, 0.0f), Vec3(0.0f, -1.0f, 0.0f), 1.0f},  // ... and before it
+      {Vec3(0.0f, -2.0f, 0.0f), Vec3(0.0f, -1.0f, 0.0f)},       // the plane behind
+  };
+  Block block;
+  const unsigned n = unsigned(std::size(rays));
+  for (unsigned i = 0; i < n; ++i) block.set(i, rays[i], true);
+  const unsigned reversed = n - 2;  // the ray whose interval ends before the plane starts past its end
+  block.tnear[reversed] = 3.0f;
+  RectangleLanes lanes;
+  const uint32_t mask = axisRectangleCrossings(block.lanes(n), rect, (1u << n) - 1u, lanes);
+  int hits = 0;
+  for (unsigned i = 0; i < n; ++i) {
+    SCOPED_TRACE(describe(rays[i]));
+    RectangleCrossing crossing;
+    const bool hit = rect.cross(rays[i], block.tnear[i], rays[i].tMax, crossing);
+    ASSERT_EQ(((mask >> i) & 1u) != 0, hit) << "lane " << i;
+    if (!hit) continue;
+    ++hits;
+    EXPECT_EQ(std::memcmp(&lanes.t[i], &crossing.t, sizeof(double)), 0);
+    EXPECT_EQ(std::memcmp(&lanes.a[i], &crossing.a, sizeof(double)), 0);
+    EXPECT_EQ(std::memcmp(&lanes.b[i], &crossing.b, sizeof(double)), 0);
+  }
+  EXPECT_GE(hits, 3);  // at least straight down, onto the edge and onto the corner
+  // The quad's hit is the rectangle's crossing.
+  const Quad quad({v0, v1, v2, v3}, {Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)});
+  LocalHit h;
+  ASSERT_TRUE(quad.intersect(rays[0], 0.0f, kInfinity, h));
+  RectangleCrossing crossing;
+  ASSERT_TRUE(rect.cross(rays[0], 0.0f, kInfinity, crossing));
+  EXPECT_EQ(h.t, float(crossing.t));
 }
 
 // Only quads that are exactly axis-aligned rectangles take the exact rectangle's route.
