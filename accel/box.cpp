@@ -48,7 +48,7 @@ void Box::intersectLanes(const RayLanes& rays, LaneHits& out) const {
   for (uint32_t bits = out.mask; bits != 0; bits &= bits - 1) {
     const unsigned i = unsigned(__builtin_ctz(bits));
     const glm::dvec3 local(crossings.local[0][i], crossings.local[1][i], crossings.local[2][i]);
-    out.hit[i] = faceHit({crossings.t[i], local, int(crossings.axis[i])});
+    out.set(i, faceHit({crossings.t[i], local, int(crossings.axis[i])}));
   }
 }
 

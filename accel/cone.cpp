@@ -68,15 +68,15 @@ void Cone::intersectLanes(const RayLanes& rays, LaneHits& out) const {
   std::copy_n(rays.tfar, rays.n, tMax);
   for (uint32_t bits = out.mask; bits != 0; bits &= bits - 1) {
     const unsigned i = unsigned(__builtin_ctz(bits));
-    out.hit[i] = lateralHit({roots.t[i], roots.x[i], roots.y[i], roots.z[i]});
-    tMax[i] = out.hit[i].t;
+    out.set(i, lateralHit({roots.t[i], roots.x[i], roots.y[i], roots.z[i]}));
+    tMax[i] = out.t[i];
   }
   if (!capBase_) return;
   DiscLanes crossings;
   const uint32_t capped = discCrossings(rays, cap_.exact, tMax, live, crossings);
   for (uint32_t bits = capped; bits != 0; bits &= bits - 1) {
     const unsigned i = unsigned(__builtin_ctz(bits));
-    out.hit[i] = cap_.hitAt({crossings.t[i], crossings.x[i], crossings.y[i]});
+    out.set(i, cap_.hitAt({crossings.t[i], crossings.x[i], crossings.y[i]}));
   }
   out.mask |= capped;
 }

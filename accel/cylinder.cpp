@@ -62,8 +62,8 @@ void Cylinder::intersectLanes(const RayLanes& rays, LaneHits& out) const {
   std::copy_n(rays.tfar, rays.n, tMax);
   for (uint32_t bits = out.mask; bits != 0; bits &= bits - 1) {
     const unsigned i = unsigned(__builtin_ctz(bits));
-    out.hit[i] = lateralHit({roots.t[i], roots.x[i], roots.y[i], roots.z[i]});
-    tMax[i] = out.hit[i].t;
+    out.set(i, lateralHit({roots.t[i], roots.x[i], roots.y[i], roots.z[i]}));
+    tMax[i] = out.t[i];
   }
   if (!caps_) return;
   for (const DiscGeometry* cap : {&cap0_, &cap1_}) {
@@ -71,8 +71,8 @@ void Cylinder::intersectLanes(const RayLanes& rays, LaneHits& out) const {
     const uint32_t capped = discCrossings(rays, cap->exact, tMax, live, crossings);
     for (uint32_t bits = capped; bits != 0; bits &= bits - 1) {
       const unsigned i = unsigned(__builtin_ctz(bits));
-      out.hit[i] = cap->hitAt({crossings.t[i], crossings.x[i], crossings.y[i]});
-      tMax[i] = out.hit[i].t;
+      out.set(i, cap->hitAt({crossings.t[i], crossings.x[i], crossings.y[i]}));
+      tMax[i] = out.t[i];
     }
     out.mask |= capped;
   }

@@ -41,7 +41,7 @@ void Disc::intersectLanes(const RayLanes& rays, LaneHits& out) const {
   out.mask = discCrossings(rays, disc_.exact, rays.tfar, candidateLanes(rays), crossings);
   for (uint32_t bits = out.mask; bits != 0; bits &= bits - 1) {
     const unsigned i = unsigned(__builtin_ctz(bits));
-    out.hit[i] = disc_.hitAt({crossings.t[i], crossings.x[i], crossings.y[i]});
+    out.set(i, disc_.hitAt({crossings.t[i], crossings.x[i], crossings.y[i]}));
   }
 }
 

@@ -22,10 +22,8 @@ class FlippedShape final : public Shape {
   uint32_t candidateLanes(const RayLanes& rays) const override { return inner_->candidateLanes(rays); }
   void intersectLanes(const RayLanes& rays, LaneHits& out) const override {
     inner_->intersectLanes(rays, out);
-    for (uint32_t bits = out.mask; bits != 0; bits &= bits - 1) {
-      LocalHit& h = out.hit[__builtin_ctz(bits)];
-      h.ng = -h.ng;
-    }
+    for (auto& row : out.ng)
+      for (float& x : row) x = -x;
   }
   Vec2 surfaceUv(const LocalHit& hit) const override {
     LocalHit original = hit;

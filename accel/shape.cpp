@@ -3,17 +3,21 @@
 namespace ember {
 
 uint32_t Shape::candidateLanes(const RayLanes& rays) const {
-  uint32_t bits = 0;
-  for (unsigned i = 0; i < rays.n; ++i)
-    if (rays.valid[i] == -1) bits |= 1u << i;
-  return bits;
+  return liveLanes(rays);
 }
 
 void Shape::intersectLanes(const RayLanes& rays, LaneHits& out) const {
   out.mask = 0;
-  for (uint32_t bits = candidateLanes(rays); bits != 0; bits &= bits - 1) {
+  intersectEach(candidateLanes(rays), rays, out);
+}
+
+void Shape::intersectEach(uint32_t lanes, const RayLanes& rays, LaneHits& out) const {
+  for (uint32_t bits = lanes; bits != 0; bits &= bits - 1) {
     const unsigned i = unsigned(__builtin_ctz(bits));
-    if (intersect(rays.ray(i), rays.tnear[i], rays.tfar[i], out.hit[i])) out.mask |= 1u << i;
+    LocalHit hit;
+    if (!intersect(rays.ray(i), rays.tnear[i], rays.tfar[i], hit)) continue;
+    out.set(i, hit);
+    out.mask |= 1u << i;
   }
 }
 

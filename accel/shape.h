@@ -28,20 +28,6 @@ struct Bounds {
   bool empty() const { return lower.x > upper.x; }
 };
 
-// What an intersection routine reports: enough to rebuild the full surface record later.
-struct LocalHit {
-  float t = kInfinity;
-  Vec3 ng{0.0f};  // unit geometric normal, outward / front side
-  Vec2 uv{0.0f};
-};
-
-// The hits of a block of packet lanes (Shape::intersectLanes): bit i of `mask` set when lane i
-// hit, with its hit in hit[i].
-struct LaneHits {
-  uint32_t mask = 0;
-  LocalHit hit[RayLanes::kMaxLanes];
-};
-
 // A hit point rebuilt on the surface, with the bound of its rounding error (core/ray_spawn.h).
 struct SurfacePoint {
   Vec3 p;
@@ -107,6 +93,10 @@ class Shape {
   // sampleSolidAngle for the live lanes of `lanes` at once (accel/sampling_lanes.h), a pdf of 0
   // where it returns false. Shapes with a lane kernel override it; the default goes lane by lane.
   virtual void sampleSolidAngleLanes(SolidAngleLanes& lanes) const;
+
+ protected:
+  // intersect() on each lane of `lanes`, adding the lanes it hits to out.mask.
+  void intersectEach(uint32_t lanes, const RayLanes& rays, LaneHits& out) const;
 };
 
 // A plane dot(n, x) = d in double precision (n of unit length), precomputed so that projecting a

@@ -85,6 +85,17 @@ unsigned RayLanesStep() {
   return unsigned(hn::Lanes(D()));
 }
 
+uint32_t LiveLanes(const RayLanes& rays) {
+  const D d;
+  const hn::RebindToSigned<D> di;
+  const unsigned step = unsigned(hn::Lanes(d));
+  uint32_t bits = 0;
+  for (unsigned i = 0; i < rays.n; i += step)
+    bits |= maskBits(d, hn::RebindMask(d, hn::Eq(hn::LoadU(di, rays.valid + i), hn::Set(di, -1)))) << i;
+  const uint32_t inRange = rays.n >= 32 ? ~0u : (1u << rays.n) - 1u;
+  return bits & inRange;
+}
+
 void TriangleLanesKernel(const RayLanes& rays, const TriangleFilter& tri, TriangleLanes& out) {
   const D d;
   const Vec3V n = splat(d, tri.n), v0 = splat(d, tri.v0), g1 = splat(d, tri.g1), g2 = splat(d, tri.g2);
@@ -189,7 +200,7 @@ uint32_t SphereCandidates(const RayLanes& rays, const Vec3& center, float radius
 // HWY_SCALAR and EMU128 targets (CPUs without SSSE3) DemoteTo clamps a t beyond FLT_MAX to
 // FLT_MAX where float(t) gives infinity: only a ray whose direction is ~1e-30 long can reach it.
 uint32_t SphereHitsKernel(const RayLanes& rays, const Vec3& center, float radius, uint32_t candidates,
-                          SphereHits& out) {
+                          LaneHits& out) {
   const D64 d;
   const hn::Rebind<float, D64> df;
   const unsigned step = unsigned(hn::Lanes(d));
@@ -275,6 +286,7 @@ HWY_AFTER_NAMESPACE();
 namespace ember {
 
 HWY_EXPORT(RayLanesStep);
+HWY_EXPORT(LiveLanes);
 HWY_EXPORT(TriangleLanesKernel);
 HWY_EXPORT(SphereCandidates);
 HWY_EXPORT(SphereHitsKernel);
@@ -310,6 +322,10 @@ unsigned rayLanesStep() {
   return step;
 }
 
+uint32_t liveLanes(const RayLanes& rays) {
+  return HWY_DYNAMIC_DISPATCH(LiveLanes)(rays);
+}
+
 void triangleLanes(const RayLanes& rays, const TriangleFilter& tri, TriangleLanes& out) {
   HWY_DYNAMIC_DISPATCH(TriangleLanesKernel)(rays, tri, out);
 }
@@ -319,7 +335,7 @@ uint32_t sphereCandidates(const RayLanes& rays, const Vec3& center, float radius
 }
 
 uint32_t sphereHits(const RayLanes& rays, const Vec3& center, float radius, uint32_t candidates,
-                    SphereHits& out) {
+                    LaneHits& out) {
   return HWY_DYNAMIC_DISPATCH(SphereHitsKernel)(rays, center, radius, candidates, out);
 }
 

@@ -44,6 +44,42 @@ struct RayLanes {
   }
 };
 
+// What an intersection routine reports: enough to rebuild the full surface record later.
+struct LocalHit {
+  float t = kInfinity;
+  Vec3 ng{0.0f};  // unit geometric normal, outward / front side
+  Vec2 uv{0.0f};
+};
+
+// The hits of a block of packet lanes (Shape::intersectLanes): bit i of `mask` set when lane i
+// hit, with its hit in lane i of the arrays. Structure of arrays, as Embree's RTCHitN is: the
+// callback commits a block's hits with vector loads and stores (accel/packet_commit.h), and the
+// kernels write their t and normals as vectors.
+struct LaneHits {
+  static constexpr unsigned kLanes = RayLanes::kMaxLanes;
+  uint32_t mask = 0;
+  alignas(64) float t[kLanes];
+  alignas(64) float ng[3][kLanes];
+  alignas(64) float uv[2][kLanes];
+
+  void set(unsigned i, const LocalHit& h) {
+    t[i] = h.t;
+    ng[0][i] = h.ng.x, ng[1][i] = h.ng.y, ng[2][i] = h.ng.z;
+    uv[0][i] = h.uv.x, uv[1][i] = h.uv.y;
+  }
+  LocalHit at(unsigned i) const {
+    return LocalHit{t[i], Vec3(ng[0][i], ng[1][i], ng[2][i]), Vec2(uv[0][i], uv[1][i])};
+  }
+  // Every lane's normal n, and texture coordinates (0, 0): a flat shape's hits, before their t
+  // (and, where wanted, uv) are written.
+  void fillFlat(const Vec3& n) {
+    for (unsigned i = 0; i < kLanes; ++i) {
+      ng[0][i] = n.x, ng[1][i] = n.y, ng[2][i] = n.z;
+      uv[0][i] = uv[1][i] = 0.0f;
+    }
+  }
+};
+
 // A triangle (v0, v1, v2) as its float filter sees it: the plane dot(n, x) = d, and the dual
 // vectors g1, g2 with b1 = dot(p - v0, g1), b2 = dot(p - v0, g2) for a point p of the plane
 // (the barycentrics of v1 and v2; Moller-Trumbore's u and v). With `parallelogram` it stands for
@@ -80,6 +116,9 @@ struct TriangleLanes {
 // floats; any other n needs arrays of kMaxLanes.
 unsigned rayLanesStep();
 
+// Bit i set: lane i is live (valid[i] == -1).
+uint32_t liveLanes(const RayLanes& rays);
+
 void triangleLanes(const RayLanes& rays, const TriangleFilter& tri, TriangleLanes& out);
 
 // Bit i set: live lane i may hit the sphere (its discriminant may be >= 0).
@@ -87,13 +126,9 @@ uint32_t sphereCandidates(const RayLanes& rays, const Vec3& center, float radius
 
 // Sphere::intersect of the lanes in `candidates`, all at once in double precision and equal to it
 // bit for bit: bit i of the result set when lane i hits, with its t and unit normal in lane i of
-// `out`.
-struct SphereHits {
-  alignas(64) float t[RayLanes::kMaxLanes];
-  alignas(64) float ng[3][RayLanes::kMaxLanes];
-};
+// `out` (its uv is left as it was).
 uint32_t sphereHits(const RayLanes& rays, const Vec3& center, float radius, uint32_t candidates,
-                    SphereHits& out);
+                    LaneHits& out);
 
 // The settled hits of a flat shape (the lanes its kernel found certainly inside), all at once in
 // double precision and equal bit for bit to DoublePlane::crossedWithin(ray, tnear, tfar,

@@ -3,6 +3,9 @@
 #include "accel/solve.h"
 #include "core/sampling.h"
 
+#include <algorithm>
+#include <iterator>
+
 namespace ember {
 
 Bounds Sphere::bounds() const {
@@ -41,12 +44,8 @@ bool Sphere::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) co
 }
 
 void Sphere::intersectLanes(const RayLanes& rays, LaneHits& out) const {
-  SphereHits lanes;
-  out.mask = sphereHits(rays, center_, radius_, candidateLanes(rays), lanes);
-  for (uint32_t bits = out.mask; bits != 0; bits &= bits - 1) {
-    const unsigned i = unsigned(__builtin_ctz(bits));
-    out.hit[i] = LocalHit{lanes.t[i], Vec3(lanes.ng[0][i], lanes.ng[1][i], lanes.ng[2][i]), Vec2(0.0f)};
-  }
+  out.mask = sphereHits(rays, center_, radius_, candidateLanes(rays), out);
+  for (auto& row : out.uv) std::fill(std::begin(row), std::end(row), 0.0f);  // surfaceUv derives it
 }
 
 SurfacePoint Sphere::projectToSurface(const Vec3& p, const LocalHit&) const {

@@ -36,6 +36,11 @@ static Vec2 uvAt(const Vec2& uv0, const Vec2& uv1, const Vec2& uv2, float b1, fl
   return (1.0f - b1 - b2) * uv0 + b1 * uv1 + b2 * uv2;
 }
 
+static void setUv(LaneHits& hits, unsigned i, Vec2 uv) {
+  hits.uv[0][i] = uv.x;
+  hits.uv[1][i] = uv.y;
+}
+
 static Vec3 frontNormal(const Vec3& v0, const Vec3& v1, const Vec3& v2) {
   return glm::normalize(glm::cross(v1 - v0, v2 - v0));
 }
@@ -82,16 +87,13 @@ void Triangle::intersectLanes(const RayLanes& rays, LaneHits& out) const {
   // crossing point's plane coordinates, both in double as Moller-Trumbore has them.
   PlaneCrossings crossings;
   out.mask = planeCrossings(rays, plane_, coords_, lanes.inside, rays.needsUv, crossings);
+  out.fillFlat(normal_);
   for (uint32_t bits = out.mask; bits != 0; bits &= bits - 1) {
     const unsigned i = unsigned(__builtin_ctz(bits));
-    const Vec2 uv =
-        rays.needsUv ? uvAt(uv_[0], uv_[1], uv_[2], crossings.b[0][i], crossings.b[1][i]) : Vec2(0.0f);
-    out.hit[i] = LocalHit{crossings.t[i], normal_, uv};
+    out.t[i] = crossings.t[i];
+    if (rays.needsUv) setUv(out, i, uvAt(uv_[0], uv_[1], uv_[2], crossings.b[0][i], crossings.b[1][i]));
   }
-  for (uint32_t bits = lanes.candidates & ~lanes.inside; bits != 0; bits &= bits - 1) {
-    const unsigned i = unsigned(__builtin_ctz(bits));
-    if (intersect(rays.ray(i), rays.tnear[i], rays.tfar[i], out.hit[i])) out.mask |= 1u << i;
-  }
+  intersectEach(lanes.candidates & ~lanes.inside, rays, out);
 }
 
 bool Triangle::sampleSolidAngle(const Vec3& ref, Vec2 u, ShapeSample& s, float& pdf) const {
@@ -194,7 +196,7 @@ bool Quad::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) cons
   if (axisAligned_) {
     RectangleCrossing crossing;
     if (!exactRectangle_.cross(ray, tMin, tMax, crossing)) return false;
-    rectangleHit(crossing, true, hit);
+    hit = LocalHit{float(crossing.t), normal_, rectangleUv(crossing.a, crossing.b)};
     return true;
   }
   if (!intersectHalf(0, ray, tMin, tMax, hit)) return intersectHalf(1, ray, tMin, tMax, hit);
@@ -216,18 +218,11 @@ bool Quad::settledHit(int half, const Ray& ray, float tMin, float tMax, bool nee
   return true;
 }
 
-// Field by field into the caller's record: built in a temporary and copied, the hit's narrow
-// stores were reloaded by a wide load before they reached the cache (`perf annotate`: a fifth of
-// intersectLanes on one instruction).
-void Quad::rectangleHit(const RectangleCrossing& crossing, bool needsUv, LocalHit& hit) const {
-  hit.t = float(crossing.t);
-  hit.ng = normal_;
-  hit.uv = Vec2(0.0f);
-  if (needsUv) {
-    const ExactAxisRectangle& r = exactRectangle_;
-    hit.uv = parallelogramUv(
-        Vec2(float((crossing.a - r.corner[0]) / r.edge[0]), float((crossing.b - r.corner[1]) / r.edge[1])));
-  }
+// The UV of an axis-aligned rectangle's crossing at coordinates (a, b), from intersect() and
+// intersectLanes() alike.
+Vec2 Quad::rectangleUv(double a, double b) const {
+  const ExactAxisRectangle& r = exactRectangle_;
+  return parallelogramUv(Vec2(float((a - r.corner[0]) / r.edge[0]), float((b - r.corner[1]) / r.edge[1])));
 }
 
 Vec2 Quad::parallelogramUv(Vec2 b) const {
@@ -269,9 +264,11 @@ void Quad::intersectLanes(const RayLanes& rays, LaneHits& out) const {
     // rectangle's bounding box has crossed its plane within its bounds, so it nearly always hits.
     RectangleLanes crossings;
     out.mask = axisRectangleCrossings(rays, exactRectangle_, Shape::candidateLanes(rays), crossings);
+    out.fillFlat(normal_);
     for (uint32_t bits = out.mask; bits != 0; bits &= bits - 1) {
       const unsigned i = unsigned(__builtin_ctz(bits));
-      rectangleHit({crossings.t[i], crossings.a[i], crossings.b[i]}, rays.needsUv, out.hit[i]);
+      out.t[i] = float(crossings.t[i]);
+      if (rays.needsUv) setUv(out, i, rectangleUv(crossings.a[i], crossings.b[i]));
     }
     return;
   }
@@ -283,17 +280,13 @@ void Quad::intersectLanes(const RayLanes& rays, LaneHits& out) const {
     // others by the exact test.
     PlaneCrossings crossings;
     out.mask = planeCrossings(rays, planes_[0], coords_[0], first.inside, rays.needsUv, crossings);
+    out.fillFlat(normal_);
     for (uint32_t bits = out.mask; bits != 0; bits &= bits - 1) {
       const unsigned i = unsigned(__builtin_ctz(bits));
-      LocalHit& h = out.hit[i];
-      h.t = crossings.t[i];
-      h.ng = normal_;
-      h.uv = rays.needsUv ? parallelogramUv(Vec2(crossings.b[0][i], crossings.b[1][i])) : Vec2(0.0f);
+      out.t[i] = crossings.t[i];
+      if (rays.needsUv) setUv(out, i, parallelogramUv(Vec2(crossings.b[0][i], crossings.b[1][i])));
     }
-    for (uint32_t bits = first.candidates & ~first.inside; bits != 0; bits &= bits - 1) {
-      const unsigned i = unsigned(__builtin_ctz(bits));
-      if (intersect(rays.ray(i), rays.tnear[i], rays.tfar[i], out.hit[i])) out.mask |= 1u << i;
-    }
+    intersectEach(first.candidates & ~first.inside, rays, out);
     return;
   }
   TriangleLanes second;
@@ -303,7 +296,7 @@ void Quad::intersectLanes(const RayLanes& rays, LaneHits& out) const {
     const uint32_t bit = 1u << i;
     const Ray ray = rays.ray(i);
     const float tMin = rays.tnear[i];
-    LocalHit& h = out.hit[i];
+    LocalHit h;
     auto half = [&](int k, const TriangleLanes& lanes, float tMax, LocalHit& hit) {
       if (!(lanes.candidates & bit)) return false;
       if (lanes.inside & bit) return settledHit(k, ray, tMin, tMax, rays.needsUv, hit);
@@ -315,6 +308,7 @@ void Quad::intersectLanes(const RayLanes& rays, LaneHits& out) const {
     } else if (!half(1, second, ray.tMax, h)) {
       continue;
     }
+    out.set(i, h);
     out.mask |= bit;
   }
 }

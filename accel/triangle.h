@@ -74,8 +74,8 @@ class Quad final : public Shape {
   bool settledHit(int half, const Ray& ray, float tMin, float tMax, bool needsUv, LocalHit& hit) const;
   // The UV of the point with coordinates b in the single filter's parallelogram (v0, v1, v3).
   Vec2 parallelogramUv(Vec2 b) const;
-  // The hit of an axis-aligned rectangle's crossing, from intersect() and intersectLanes() alike.
-  void rectangleHit(const RectangleCrossing& crossing, bool needsUv, LocalHit& hit) const;
+  // The UV of an axis-aligned rectangle's crossing at coordinates (a, b).
+  Vec2 rectangleUv(double a, double b) const;
 
   bool rectangle_;
   std::array<Vec3, 4> v_;

@@ -1,5 +1,6 @@
 #include "accel/user_geometry.h"
 
+#include "accel/packet_commit.h"
 #include "accel/packet_tfar.h"
 #include "accel/shape.h"
 
@@ -86,20 +87,18 @@ class PacketLanes {
   bool needsUv_;
 };
 
-// Calls report(lane, hit) for each live lane of the packet that hits the shape, as the shape's
-// intersectLanes decides it. Single rays take the same route (a padded block of one live lane),
-// so a packet finds exactly the hits single rays find.
+// Calls report(first, count, hits) for each block of the packet's lanes [first, first + count)
+// with the block's hits, as the shape's intersectLanes decides them. Single rays take the same
+// route (a padded block of one live lane), so a packet finds exactly the hits single rays find.
 template <typename Report>
 void intersectPacket(const Shape& shape, bool needsUv, RTCRayN* rays, unsigned n, const int* valid,
                      Report report) {
   PacketLanes packet(rays, n, valid, needsUv);
   thread_local LaneHits hits;  // the thread's own: 16 hit records not rebuilt per call
   for (unsigned k = 0; k < packet.blocks(); ++k) {
-    shape.intersectLanes(packet.block(k), hits);
-    for (uint32_t bits = hits.mask; bits != 0; bits &= bits - 1) {
-      const unsigned lane = unsigned(__builtin_ctz(bits));
-      report(k * RayLanes::kMaxLanes + lane, hits.hit[lane]);
-    }
+    const RayLanes block = packet.block(k);
+    shape.intersectLanes(block, hits);
+    if (hits.mask != 0) report(k * RayLanes::kMaxLanes, block.n, hits);
   }
 }
 
@@ -117,25 +116,12 @@ void shapeIntersectCallback(const RTCIntersectFunctionNArguments* args) {
   float tfar[kPacketTfarLanes];
   float* rayTfar = &RTCRayN_tfar(rays, n, 0);
   widenLiveTfar(rayTfar, args->valid, tfar, n);
+  // A hit at exactly the current tfar ties with the hit found there: the smaller geomID keeps it
+  // (commitLaneHits), so that the result does not depend on the order Embree visits the shapes in.
   intersectPacket(*geometry->shape, geometry->needsUv, rays, n, args->valid,
-                  [&](unsigned i, const LocalHit& h) {
-                    if (!(h.t <= tfar[i])) return;
-                    // A hit at exactly the current tfar ties with the hit found there: the smaller
-                    // geomID keeps it, so that the result does not depend on the order Embree visits
-                    // the shapes in. With no hit yet, tfar is the ray's own end, which is open.
-                    if (h.t == tfar[i]) {
-                      const unsigned current = RTCHitN_geomID(hits, n, i);
-                      if (current == RTC_INVALID_GEOMETRY_ID || current <= args->geomID) return;
-                    }
-                    tfar[i] = h.t;
-                    RTCHitN_Ng_x(hits, n, i) = h.ng.x;
-                    RTCHitN_Ng_y(hits, n, i) = h.ng.y;
-                    RTCHitN_Ng_z(hits, n, i) = h.ng.z;
-                    RTCHitN_u(hits, n, i) = h.uv.x;
-                    RTCHitN_v(hits, n, i) = h.uv.y;
-                    RTCHitN_primID(hits, n, i) = args->primID;
-                    RTCHitN_geomID(hits, n, i) = args->geomID;
-                    RTCHitN_instID(hits, n, i, 0) = args->context->instID[0];
+                  [&](unsigned first, unsigned count, const LaneHits& found) {
+                    commitLaneHits(found, count, tfar + first, hits, n, first, args->primID, args->geomID,
+                                   args->context->instID[0]);
                   });
   storeLiveTfar(rayTfar, args->valid, tfar, n);
 }
@@ -144,7 +130,10 @@ void shapeOccludedCallback(const RTCOccludedFunctionNArguments* args) {
   const auto* shape = static_cast<const ShapeGeometry*>(args->geometryUserPtr)->shape;
   // Embree 3 reports an occluded ray by setting tfar to -infinity.
   intersectPacket(*shape, false, args->ray, args->N, args->valid,
-                  [&](unsigned i, const LocalHit&) { RTCRayN_tfar(args->ray, args->N, i) = -kInfinity; });
+                  [&](unsigned first, unsigned, const LaneHits& found) {
+                    for (uint32_t bits = found.mask; bits != 0; bits &= bits - 1)
+                      RTCRayN_tfar(args->ray, args->N, first + unsigned(__builtin_ctz(bits))) = -kInfinity;
+                  });
 }
 
 }  // namespace ember

@@ -12,6 +12,7 @@
 #include "accel/cylinder.h"
 #include "accel/disc.h"
 #include "accel/flipped_shape.h"
+#include "accel/packet_commit.h"
 #include "accel/packet_tfar.h"
 #include "accel/sphere.h"
 #include "accel/triangle.h"
@@ -150,22 +151,22 @@ void check(const Shape& shape, const RayMaker& make, int blocks, uint64_t seed, 
       for (unsigned k = 0; k < RayLanes::kMaxLanes; ++k) alone.valid[k] = k == i ? -1 : 0;
       LaneHits aloneHits;
       shape.intersectLanes(alone.lanes(), aloneHits);
-      if (laneHit && (noUvHits.hit[i].t != laneHits.hit[i].t || noUvHits.hit[i].ng != laneHits.hit[i].ng))
+      if (laneHit && (noUvHits.at(i).t != laneHits.at(i).t || noUvHits.at(i).ng != laneHits.at(i).ng))
         ++t.uvSkipDiffers;
       if (aloneHits.mask != (laneHit ? 1u << i : 0u) ||
-          (laneHit && !identical(aloneHits.hit[i], laneHits.hit[i])))
+          (laneHit && !identical(aloneHits.at(i), laneHits.at(i))))
         ++t.aloneDiffers;
       LocalHit h;
       const bool hit = shape.intersect(rays[i], block.tnear[i], rays[i].tMax, h);
-      if (exactLanes && hit && laneHit && !identical(laneHits.hit[i], h)) ++t.notIdentical;
-      if (laneHit != hit || (hit && !sameHit(laneHits.hit[i], h, uvScale))) {
+      if (exactLanes && hit && laneHit && !identical(laneHits.at(i), h)) ++t.notIdentical;
+      if (laneHit != hit || (hit && !sameHit(laneHits.at(i), h, uvScale))) {
         ++(laneHit != hit ? t.laneDisagrees : t.laneInexact);
         if (t.laneExample.empty()) {
           char buf[160];
           std::snprintf(buf, sizeof buf,
                         ": lanes %s t %.9g uv (%.7g %.7g), intersect() %s t %.9g uv (%.7g %.7g)",
-                        laneHit ? "hit" : "miss", laneHits.hit[i].t, laneHits.hit[i].uv.x,
-                        laneHits.hit[i].uv.y, hit ? "hit" : "miss", h.t, h.uv.x, h.uv.y);
+                        laneHit ? "hit" : "miss", laneHits.at(i).t, laneHits.at(i).uv.x, laneHits.at(i).uv.y,
+                        hit ? "hit" : "miss", h.t, h.uv.x, h.uv.y);
           t.laneExample = describe(rays[i]) + buf;
         }
       }
@@ -628,7 +629,7 @@ TEST(ShapeLanes, SphereLaneWithAZeroDirectionGetsTheScalarResult) {
     const bool hit = sphere.intersect(block.lanes().ray(i), block.tnear[i], block.tfar[i], h);
     ASSERT_EQ(((hits.mask >> i) & 1u) != 0, hit) << "lane " << i;
     if (hit) {
-      EXPECT_TRUE(identical(hits.hit[i], h)) << "lane " << i;
+      EXPECT_TRUE(identical(hits.at(i), h)) << "lane " << i;
     }
   }
   EXPECT_FALSE((hits.mask >> 5) & 1u);
@@ -695,7 +696,7 @@ TEST(ShapeLanes, DegenerateDirectionsGetTheScalarResult) {
             << "lane " << i << ": " << describe(block.lanes().ray(i));
         if (hit) {
           ++hitCount;
-          EXPECT_TRUE(identical(hits.hit[i], h)) << "lane " << i << ": " << describe(block.lanes().ray(i));
+          EXPECT_TRUE(identical(hits.at(i), h)) << "lane " << i << ": " << describe(block.lanes().ray(i));
         }
       }
     }
@@ -748,5 +749,64 @@ TEST(PacketTfar, VectorPassesEqualTheScalarLoops) {
   }
 }
 
+// The callback's vector commit against the scalar rule it replaced, lane by lane: ties at tfar
+// (kept only over a larger geometry ID, never over none), NaN, infinite and equal t, blocks of
+// every width Embree calls with at any offset in a 16-ray packet, and the packet's other lanes
+// untouched.
+TEST(PacketCommit, VectorCommitEqualsTheScalarRule) {
+  Rng rng(11, 3);
+  constexpr unsigned kLanes = RayLanes::kMaxLanes;
+  const float special[] = {kInfinity, 0.0f, 2.0f, std::numeric_limits<float>::quiet_NaN(), 1e-30f};
+  const uint32_t geometries[] = {RTC_INVALID_GEOMETRY_ID, 0u, 4u, 5u, 6u, 0x7fffffffu, 0x80000000u};
+  const uint32_t ours = 5u;
+  int kept = 0, ties = 0;
+  for (const unsigned n : {16u, 8u, 4u, 1u, 13u, 7u}) {
+    for (int trial = 0; trial < 300; ++trial) {
+      const unsigned first = rng.nextU32() % (kLanes - n + 1);
+      LaneHits hits;
+      hits.mask = 0;
+      alignas(64) float tfar[kLanes];
+      // A 16-ray packet's RTCHitN: each field an array of 16, in Embree's order.
+      struct Packet {
+        float ng[3][kLanes], u[kLanes], v[kLanes];
+        uint32_t prim[kLanes], geom[kLanes], inst[kLanes];
+      } got, want;
+      for (unsigned i = 0; i < kLanes; ++i) {
+        tfar[i] = rng.uniform() < 0.3f ? special[rng.nextU32() % 5] : 10.0f * rng.uniform();
+        const bool tie = rng.uniform() < 0.3f;
+        hits.t[i] = tie ? tfar[i] : rng.uniform() < 0.2f ? special[rng.nextU32() % 5] : 10.0f * rng.uniform();
+        for (int c = 0; c < 3; ++c) hits.ng[c][i] = rng.uniform() - 0.5f;
+        hits.uv[0][i] = rng.uniform(), hits.uv[1][i] = rng.uniform();
+        if (i < n && rng.uniform() < 0.7f) hits.mask |= 1u << i;
+        for (int c = 0; c < 3; ++c) got.ng[c][i] = -3.0f - float(c);
+        got.u[i] = -6.0f, got.v[i] = -7.0f;
+        got.prim[i] = 900u + i, got.geom[i] = geometries[rng.nextU32() % 7], got.inst[i] = 800u + i;
+      }
+      want = got;
+      alignas(64) float wantTfar[kLanes];
+      std::memcpy(wantTfar, tfar, sizeof(tfar));
+      for (unsigned i = 0; i < n; ++i) {
+        const unsigned lane = first + i;
+        if (!((hits.mask >> i) & 1u)) continue;
+        const float t = hits.t[i];
+        if (!(t <= wantTfar[i])) continue;
+        if (t == wantTfar[i]) {
+          ++ties;
+          if (want.geom[lane] == RTC_INVALID_GEOMETRY_ID || want.geom[lane] <= ours) continue;
+        }
+        ++kept;
+        wantTfar[i] = t;
+        for (int c = 0; c < 3; ++c) want.ng[c][lane] = hits.ng[c][i];
+        want.u[lane] = hits.uv[0][i], want.v[lane] = hits.uv[1][i];
+        want.prim[lane] = 17u, want.geom[lane] = ours, want.inst[lane] = 23u;
+      }
+      commitLaneHits(hits, n, tfar, reinterpret_cast<RTCHitN*>(&got), kLanes, first, 17u, ours, 23u);
+      ASSERT_EQ(0, std::memcmp(tfar, wantTfar, sizeof(tfar))) << "n " << n << " trial " << trial;
+      ASSERT_EQ(0, std::memcmp(&got, &want, sizeof(got))) << "n " << n << " trial " << trial;
+    }
+  }
+  EXPECT_GT(kept, 1000);
+  EXPECT_GT(ties, 300);
+}
 }  // namespace
 }  // namespace ember
