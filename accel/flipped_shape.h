@@ -35,11 +35,6 @@ class FlippedShape final : public Shape {
     original.ng = -hit.ng;
     return inner_->projectToSurface(p, original);
   }
-  Vec3 shadingNormal(const Vec3& p, const LocalHit& hit) const override {
-    LocalHit original = hit;
-    original.ng = -hit.ng;
-    return -inner_->shadingNormal(p, original);
-  }
   float area() const override { return inner_->area(); }
   ShapeSample sampleArea(Vec2 u) const override {
     ShapeSample s = inner_->sampleArea(u);

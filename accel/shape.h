@@ -77,9 +77,6 @@ class Shape {
   // outside it (a leak through the rim).
   virtual SurfacePoint projectToSurface(const Vec3& p, const LocalHit& hit) const = 0;
 
-  // Shading normal at a hit point; equal to the geometric normal for every shape Ember has.
-  virtual Vec3 shadingNormal(const Vec3& /*p*/, const LocalHit& hit) const { return hit.ng; }
-
   virtual float area() const = 0;
 
   // A point distributed uniformly by area over the whole surface (density 1 / area()).

@@ -314,7 +314,15 @@ void Quad::intersectLanes(const RayLanes& rays, LaneHits& out) const {
 }
 
 SurfacePoint Quad::projectToSurface(const Vec3& p, const LocalHit&) const {
-  if (samePlanes_) return planes_[0].project(p);  // an axis-aligned rectangle, say
+  if (axisAligned_) {
+    // DoublePlane::project's arithmetic where the plane's normal is an axis (its other
+    // components are zeros, and its length one, exactly): only that coordinate moves.
+    glm::dvec3 dp(p);
+    const int k = exactRectangle_.axis;
+    dp[k] -= dp[k] - exactRectangle_.c;
+    return roundedPoint(dp);
+  }
+  if (samePlanes_) return planes_[0].project(p);
   // The diagonal v0-v2 separates the halves: v1 lies on one side of it, v3 on the other.
   const bool firstHalf = glm::dot(glm::cross(v_[2] - v_[0], p - v_[0]), normal_) <= 0.0f;
   return planes_[firstHalf ? 0 : 1].project(p);

@@ -150,7 +150,7 @@ void Scene::surfaceHit(const Ray& ray, const RawHit& raw, SurfaceHit& hit) const
     } else {
       hit.pError = roundingErrorBound(magnitude + raw.t);
     }
-    hit.ns = rec.shape->shadingNormal(hit.p, local);
+    hit.ns = raw.ng;  // every analytic shape is shaded with its geometric normal
   } else {
     hit.p = rec.mesh->pointAt(raw.primID, raw.uv.x, raw.uv.y);
     hit.pError = rec.mesh->pointError(raw.primID);

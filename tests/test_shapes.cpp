@@ -727,6 +727,46 @@ TEST(ShapeQuad, KnownHitsInBothHalves) {
   expectHit(q, makeRay({1, 0.5f, 3}, {0, 0, -1}), 3.0f, {0, 0, 1});
 }
 
+// An axis-aligned rectangle projects a hit point with the general plane's arithmetic specialised
+// to an axis normal: the same point and error bound as DoublePlane::project, for planes at zero,
+// at tiny and huge offsets, of either facing, and points near and far from them (where p[k] - c
+// is not exact, so that projecting is not simply p[k] = c).
+TEST(ShapeQuad, AxisAlignedProjectionEqualsTheGeneralPlane) {
+  Rng rng(5, 9);
+  int compared = 0, notOnPlane = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    for (const float c : {0.0f, 1e-30f, -2.5f, 5.5f, 3e7f, -1e30f}) {
+      for (const bool flip : {false, true}) {
+        const int p = (axis + 1) % 3, q = (axis + 2) % 3;
+        auto corner = [&](float a, float b) {
+          Vec3 v(0.0f);
+          v[axis] = c, v[p] = a, v[q] = b;
+          return v;
+        };
+        std::array<Vec3, 4> v = {corner(-1, -2), corner(3, -2), corner(3, 4), corner(-1, 4)};
+        if (flip) std::swap(v[1], v[3]);
+        const Quad quad(v, {Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)});
+        const DoublePlane plane = DoublePlane::through(v[0], v[1], v[2]);
+        for (int i = 0; i < 200; ++i) {
+          Vec3 x(0.0f);
+          x[p] = 8.0f * rng.uniform() - 4.0f;
+          x[q] = 8.0f * rng.uniform() - 4.0f;
+          const float scale = std::pow(10.0f, -30.0f + 40.0f * rng.uniform());
+          x[axis] = c + (rng.uniform() - 0.5f) * std::max(std::abs(c) * 1e-6f, scale);
+          const SurfacePoint got = quad.projectToSurface(x, LocalHit{});
+          const SurfacePoint want = plane.project(x);
+          ASSERT_TRUE(got.p == want.p && got.error == want.error)
+              << "axis " << axis << " c " << c << " point " << x.x << " " << x.y << " " << x.z;
+          notOnPlane += got.p[axis] != c;
+          ++compared;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(compared, 3 * 6 * 2 * 200);
+  EXPECT_GT(notOnPlane, 0);  // some points land beside c: the specialisation must keep its rounding
+}
+
 // Solid angle of a planar polygon seen from ref: Van Oosterom & Strackee (1983) per triangle.
 double triangleSolidAngle(const glm::dvec3& ref, const Vec3& a, const Vec3& b, const Vec3& c) {
   const glm::dvec3 r1 = glm::dvec3(a) - ref, r2 = glm::dvec3(b) - ref, r3 = glm::dvec3(c) - ref;
