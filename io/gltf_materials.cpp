@@ -207,7 +207,7 @@ std::shared_ptr<const Texture> GltfMaterialReader::texture(int index, int texCoo
     const Color rgb = ch >= 3 ? Color(p[0], p[1], p[2]) : Color(p[0]);
     switch (channels) {
       case Channels::SrgbRgb:
-        texels[i] = Color(srgbToLinear(rgb.x), srgbToLinear(rgb.y), srgbToLinear(rgb.z));
+        texels[i] = Color(decodeSrgb(rgb.x), decodeSrgb(rgb.y), decodeSrgb(rgb.z));
         break;
       case Channels::LinearRgb:
         texels[i] = rgb;

@@ -255,7 +255,7 @@ TextureImage readTexture(const std::string& path, ColorEncoding encoding) {
   tex.texels.resize(size_t(raw.width) * size_t(raw.height));
   for (size_t i = 0; i < tex.texels.size(); ++i) {
     Color c = pixelRgb(&raw.data[i * size_t(raw.channels)], raw.channels);
-    if (srgb) c = Color(srgbToLinear(c.x), srgbToLinear(c.y), srgbToLinear(c.z));
+    if (srgb) c = Color(decodeSrgb(c.x), decodeSrgb(c.y), decodeSrgb(c.z));
     if (!isFinite(c)) throw InputError(path + ": texture contains NaN or infinite texels");
     tex.texels[i] = glm::max(c, Color(0.0f));
   }
@@ -268,7 +268,7 @@ TextureImage textureFromBytes(const uint8_t* data, int width, int height, int ch
   for (size_t i = 0; i < tex.texels.size(); ++i) {
     const uint8_t* p = data + i * size_t(channels);
     Color c = channels >= 3 ? Color(p[0], p[1], p[2]) / 255.0f : Color(p[0] / 255.0f);
-    if (srgb) c = Color(srgbToLinear(c.x), srgbToLinear(c.y), srgbToLinear(c.z));
+    if (srgb) c = Color(decodeSrgb(c.x), decodeSrgb(c.y), decodeSrgb(c.z));
     tex.texels[i] = c;
   }
   return tex;

@@ -1,5 +1,8 @@
 #include "materials/texture.h"
 
+#include <array>
+#include <bit>
+#include <cstdint>
 #include <cstring>
 
 namespace ember {
@@ -64,6 +67,26 @@ class ColorPalette {
 };
 
 }  // namespace
+
+float decodeSrgb(float c) {
+  struct Table {
+    std::array<float, 256> encoded, linear;
+    Table() {
+      for (int b = 0; b < 256; ++b) {
+        encoded[size_t(b)] = float(b) / 255.0f;
+        linear[size_t(b)] = srgbToLinear(encoded[size_t(b)]);
+      }
+    }
+  };
+  static const Table table;
+  const float scaled = c * 255.0f + 0.5f;
+  if (scaled >= 0.0f && scaled < 256.0f) {  // false for NaN
+    const size_t b = size_t(scaled);
+    // Compared as bits: -0 must take the formula, which keeps its sign.
+    if (std::bit_cast<uint32_t>(table.encoded[b]) == std::bit_cast<uint32_t>(c)) return table.linear[b];
+  }
+  return srgbToLinear(c);
+}
 
 ImageTexture::ImageTexture(int width, int height, std::vector<Color> texels, TextureFilter filter,
                            TextureWrap wrapS, TextureWrap wrapT, const Color& scale)

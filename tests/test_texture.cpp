@@ -6,7 +6,11 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
+#include <cmath>
+#include <cstdint>
 #include <cstring>
+#include <limits>
 #include <vector>
 
 namespace ember {
@@ -31,6 +35,28 @@ void expectExactTexels(const std::vector<Color>& texels, int width, int height, 
         ASSERT_EQ(bitsOf(got[c]), bitsOf(want[c])) << "texel (" << x << ", " << y << ") channel " << c;
     }
   }
+}
+
+// The table-backed decoder equals the sRGB formula bit for bit: on the 256 values an 8-bit
+// channel decodes to, their float neighbours, and values no table holds.
+TEST(Srgb, TableDecodeEqualsTheFormula) {
+  auto same = [](float c) {
+    const float got = decodeSrgb(c), want = srgbToLinear(c);
+    return std::bit_cast<uint32_t>(got) == std::bit_cast<uint32_t>(want) ||
+           (std::isnan(got) && std::isnan(want));
+  };
+  for (int b = 0; b < 256; ++b) {
+    const float c = float(b) / 255.0f;
+    EXPECT_TRUE(same(c)) << b;
+    EXPECT_TRUE(same(std::nextafter(c, 2.0f))) << b;
+    EXPECT_TRUE(same(std::nextafter(c, -1.0f))) << b;
+  }
+  Rng rng(3, 1);
+  for (int i = 0; i < 100000; ++i) ASSERT_TRUE(same(1.2f * rng.uniform() - 0.1f)) << i;
+  for (const float c :
+       {-0.0f, 1.0f / 255.0f + 1e-9f, 255.5f / 255.0f, std::numeric_limits<float>::infinity(),
+        -std::numeric_limits<float>::infinity(), std::numeric_limits<float>::quiet_NaN(), 1e30f, -1e30f})
+    EXPECT_TRUE(same(c)) << c;
 }
 
 TEST(ImageTexture, EightBitImagesReadBackExactly) {
