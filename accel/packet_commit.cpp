@@ -40,8 +40,8 @@ void CommitLaneHits(const LaneHits& hits, unsigned n, float* tfar, RTCHitN* pack
   const auto prim = hn::Set(du, primID), inst = hn::Set(du, instID);
   unsigned i = 0;
   for (; i + step <= n; i += step) {
-    const uint8_t bits = uint8_t(hits.mask >> i);
-    const auto has = hn::LoadMaskBits(d, &bits);
+    const uint8_t bits[8] = {uint8_t(hits.mask >> i)};  // LoadMaskBits may read 8 bytes
+    const auto has = hn::LoadMaskBits(d, bits);
     if (hn::AllFalse(d, has)) continue;
     const auto t = hn::LoadU(d, hits.t + i), current = hn::LoadU(d, tfar + i);
     const auto currentGeometry = hn::LoadU(du, out.geomID + i);
@@ -81,12 +81,15 @@ void CommitLaneHits(const LaneHits& hits, unsigned n, float* tfar, RTCHitN* pack
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
+#include <cassert>
+
 namespace ember {
 
 HWY_EXPORT(CommitLaneHits);
 
 void commitLaneHits(const LaneHits& hits, unsigned n, float* tfar, RTCHitN* packet, unsigned width,
                     unsigned first, uint32_t primID, uint32_t geomID, uint32_t instID) {
+  assert(n <= RayLanes::kMaxLanes && first + n <= width);
   HWY_DYNAMIC_DISPATCH(CommitLaneHits)(hits, n, tfar, packet, width, first, primID, geomID, instID);
 }
 

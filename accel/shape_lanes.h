@@ -54,13 +54,14 @@ struct LocalHit {
 // The hits of a block of packet lanes (Shape::intersectLanes): bit i of `mask` set when lane i
 // hit, with its hit in lane i of the arrays. Structure of arrays, as Embree's RTCHitN is: the
 // callback commits a block's hits with vector loads and stores (accel/packet_commit.h), and the
-// kernels write their t and normals as vectors.
+// sphere's kernel writes its t and normals as vectors; other shapes set lanes one by one
+// (set, fillFlat). Lanes outside `mask` hold earlier values, never read as hits.
 struct LaneHits {
   static constexpr unsigned kLanes = RayLanes::kMaxLanes;
   uint32_t mask = 0;
-  alignas(64) float t[kLanes];
-  alignas(64) float ng[3][kLanes];
-  alignas(64) float uv[2][kLanes];
+  alignas(64) float t[kLanes] = {};
+  alignas(64) float ng[3][kLanes] = {};
+  alignas(64) float uv[2][kLanes] = {};
 
   void set(unsigned i, const LocalHit& h) {
     t[i] = h.t;

@@ -316,7 +316,9 @@ void Quad::intersectLanes(const RayLanes& rays, LaneHits& out) const {
 SurfacePoint Quad::projectToSurface(const Vec3& p, const LocalHit&) const {
   if (axisAligned_) {
     // DoublePlane::project's arithmetic where the plane's normal is an axis (its other
-    // components are zeros, and its length one, exactly): only that coordinate moves.
+    // components are zeros, and its length one, exactly): only that coordinate moves. The
+    // point equals the general projection's up to the sign of a zero coordinate (which the
+    // general form can turn from -0 to +0).
     glm::dvec3 dp(p);
     const int k = exactRectangle_.axis;
     dp[k] -= dp[k] - exactRectangle_.c;

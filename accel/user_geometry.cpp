@@ -94,7 +94,7 @@ template <typename Report>
 void intersectPacket(const Shape& shape, bool needsUv, RTCRayN* rays, unsigned n, const int* valid,
                      Report report) {
   PacketLanes packet(rays, n, valid, needsUv);
-  thread_local LaneHits hits;  // the thread's own: 16 hit records not rebuilt per call
+  thread_local LaneHits hits;  // the thread's own: a block's hit arrays, not rebuilt per call
   for (unsigned k = 0; k < packet.blocks(); ++k) {
     const RayLanes block = packet.block(k);
     shape.intersectLanes(block, hits);

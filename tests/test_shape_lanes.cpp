@@ -21,6 +21,7 @@
 #include "core/sampling.h"
 
 #include <gtest/gtest.h>
+#include <hwy/targets.h>
 
 #include <algorithm>
 #include <array>
@@ -750,63 +751,89 @@ TEST(PacketTfar, VectorPassesEqualTheScalarLoops) {
 }
 
 // The callback's vector commit against the scalar rule it replaced, lane by lane: ties at tfar
-// (kept only over a larger geometry ID, never over none), NaN, infinite and equal t, blocks of
-// every width Embree calls with at any offset in a 16-ray packet, and the packet's other lanes
-// untouched.
+// (kept only over a larger geometry ID, never over none), NaN, infinite, signed-zero and equal t,
+// blocks of every width at any offset in packets of 1, 4, 8 and 16 rays (hit arrays of exactly
+// that size on the heap, so that a stray lane is a sanitizer error), mask bits past the block
+// ignored, and the packet's other lanes untouched. On every SIMD target the CPU and the build have
+// (AVX-512, AVX2, SSE4, ...: 8, 8 and 4 lanes a step), not only the one dispatch picks.
 TEST(PacketCommit, VectorCommitEqualsTheScalarRule) {
-  Rng rng(11, 3);
-  constexpr unsigned kLanes = RayLanes::kMaxLanes;
-  const float special[] = {kInfinity, 0.0f, 2.0f, std::numeric_limits<float>::quiet_NaN(), 1e-30f};
-  const uint32_t geometries[] = {RTC_INVALID_GEOMETRY_ID, 0u, 4u, 5u, 6u, 0x7fffffffu, 0x80000000u};
-  const uint32_t ours = 5u;
-  int kept = 0, ties = 0;
-  for (const unsigned n : {16u, 8u, 4u, 1u, 13u, 7u}) {
-    for (int trial = 0; trial < 300; ++trial) {
-      const unsigned first = rng.nextU32() % (kLanes - n + 1);
-      LaneHits hits;
-      hits.mask = 0;
-      alignas(64) float tfar[kLanes];
-      // A 16-ray packet's RTCHitN: each field an array of 16, in Embree's order.
-      struct Packet {
-        float ng[3][kLanes], u[kLanes], v[kLanes];
-        uint32_t prim[kLanes], geom[kLanes], inst[kLanes];
-      } got, want;
-      for (unsigned i = 0; i < kLanes; ++i) {
-        tfar[i] = rng.uniform() < 0.3f ? special[rng.nextU32() % 5] : 10.0f * rng.uniform();
-        const bool tie = rng.uniform() < 0.3f;
-        hits.t[i] = tie ? tfar[i] : rng.uniform() < 0.2f ? special[rng.nextU32() % 5] : 10.0f * rng.uniform();
-        for (int c = 0; c < 3; ++c) hits.ng[c][i] = rng.uniform() - 0.5f;
-        hits.uv[0][i] = rng.uniform(), hits.uv[1][i] = rng.uniform();
-        if (i < n && rng.uniform() < 0.7f) hits.mask |= 1u << i;
-        for (int c = 0; c < 3; ++c) got.ng[c][i] = -3.0f - float(c);
-        got.u[i] = -6.0f, got.v[i] = -7.0f;
-        got.prim[i] = 900u + i, got.geom[i] = geometries[rng.nextU32() % 7], got.inst[i] = 800u + i;
-      }
-      want = got;
-      alignas(64) float wantTfar[kLanes];
-      std::memcpy(wantTfar, tfar, sizeof(tfar));
-      for (unsigned i = 0; i < n; ++i) {
-        const unsigned lane = first + i;
-        if (!((hits.mask >> i) & 1u)) continue;
-        const float t = hits.t[i];
-        if (!(t <= wantTfar[i])) continue;
-        if (t == wantTfar[i]) {
-          ++ties;
-          if (want.geom[lane] == RTC_INVALID_GEOMETRY_ID || want.geom[lane] <= ours) continue;
-        }
-        ++kept;
-        wantTfar[i] = t;
-        for (int c = 0; c < 3; ++c) want.ng[c][lane] = hits.ng[c][i];
-        want.u[lane] = hits.uv[0][i], want.v[lane] = hits.uv[1][i];
-        want.prim[lane] = 17u, want.geom[lane] = ours, want.inst[lane] = 23u;
-      }
-      commitLaneHits(hits, n, tfar, reinterpret_cast<RTCHitN*>(&got), kLanes, first, 17u, ours, 23u);
-      ASSERT_EQ(0, std::memcmp(tfar, wantTfar, sizeof(tfar))) << "n " << n << " trial " << trial;
-      ASSERT_EQ(0, std::memcmp(&got, &want, sizeof(got))) << "n " << n << " trial " << trial;
+  // Each target in turn, then back to the CPU's best, also when an assertion returns early.
+  struct RestoreTargets {
+    ~RestoreTargets() {
+      hwy::SetSupportedTargetsForTest(0);
+      hwy::GetChosenTarget().Update(hwy::SupportedTargets());
     }
+  } restore;
+  const std::vector<int64_t> targets = hwy::SupportedAndGeneratedTargets();
+  ASSERT_FALSE(targets.empty());
+  for (const int64_t target : targets) {
+    SCOPED_TRACE(hwy::TargetName(target));
+    hwy::SetSupportedTargetsForTest(target);
+    hwy::GetChosenTarget().Update(hwy::SupportedTargets());
+    Rng rng(11, 3);
+    constexpr unsigned kLanes = RayLanes::kMaxLanes;
+    const float special[] = {kInfinity, 0.0f, -0.0f, 2.0f, std::numeric_limits<float>::quiet_NaN(), 1e-30f};
+    const uint32_t geometries[] = {RTC_INVALID_GEOMETRY_ID, 0u, 4u, 5u, 6u, 0x7fffffffu, 0x80000000u};
+    const uint32_t ours = 5u;
+    // RTCHitN's fields, each an array of `width`: Ng x, y, z, u, v, primID, geomID, instID[levels].
+    constexpr unsigned kFields = 7 + RTC_MAX_INSTANCE_LEVEL_COUNT;
+    enum Field : unsigned { NgX, NgY, NgZ, U, V, Prim, Geom, Inst };
+    int kept = 0, ties = 0;
+    for (const unsigned width : {16u, 8u, 4u, 1u}) {
+      for (const unsigned n : {16u, 13u, 8u, 7u, 4u, 1u}) {
+        if (n > width) continue;
+        for (int trial = 0; trial < 200; ++trial) {
+          const unsigned first = rng.nextU32() % (width - n + 1);
+          LaneHits hits;
+          alignas(64) float tfar[kLanes];
+          for (unsigned i = 0; i < kLanes; ++i) {
+            tfar[i] = rng.uniform() < 0.3f ? special[rng.nextU32() % 6] : 10.0f * rng.uniform();
+            const bool tie = rng.uniform() < 0.3f;
+            hits.t[i] = tie                    ? tfar[i]
+                        : rng.uniform() < 0.2f ? special[rng.nextU32() % 6]
+                                               : 10.0f * rng.uniform();
+            for (int c = 0; c < 3; ++c) hits.ng[c][i] = rng.uniform() - 0.5f;
+            hits.uv[0][i] = rng.uniform(), hits.uv[1][i] = rng.uniform();
+            if (rng.uniform() < 0.7f) hits.mask |= 1u << i;  // bits past n too: they must be ignored
+          }
+          std::vector<uint32_t> got(kFields * width);
+          for (unsigned f = 0; f < kFields; ++f)
+            for (unsigned i = 0; i < width; ++i)
+              got[f * width + i] =
+                  f == Geom ? geometries[rng.nextU32() % 7] : std::bit_cast<uint32_t>(-3.0f - float(f)) + i;
+          std::vector<uint32_t> want = got;
+          alignas(64) float wantTfar[kLanes];
+          std::memcpy(wantTfar, tfar, sizeof(tfar));
+          for (unsigned i = 0; i < n; ++i) {
+            const unsigned lane = first + i;
+            if (!((hits.mask >> i) & 1u)) continue;
+            const float t = hits.t[i];
+            if (!(t <= wantTfar[i])) continue;
+            if (t == wantTfar[i]) {
+              ++ties;
+              const uint32_t current = want[Geom * width + lane];
+              if (current == RTC_INVALID_GEOMETRY_ID || current <= ours) continue;
+            }
+            ++kept;
+            wantTfar[i] = t;
+            for (unsigned c = 0; c < 3; ++c)
+              want[(NgX + c) * width + lane] = std::bit_cast<uint32_t>(hits.ng[c][i]);
+            want[U * width + lane] = std::bit_cast<uint32_t>(hits.uv[0][i]);
+            want[V * width + lane] = std::bit_cast<uint32_t>(hits.uv[1][i]);
+            want[Prim * width + lane] = 17u, want[Geom * width + lane] = ours,
+                                want[Inst * width + lane] = 23u;
+          }
+          commitLaneHits(hits, n, tfar, reinterpret_cast<RTCHitN*>(got.data()), width, first, 17u, ours, 23u);
+          const std::string where = "width " + std::to_string(width) + " n " + std::to_string(n) + " trial " +
+                                    std::to_string(trial);
+          ASSERT_EQ(0, std::memcmp(tfar, wantTfar, sizeof(tfar))) << where;
+          ASSERT_EQ(got, want) << where;
+        }
+      }
+    }
+    EXPECT_GT(kept, 2000);
+    EXPECT_GT(ties, 600);
   }
-  EXPECT_GT(kept, 1000);
-  EXPECT_GT(ties, 300);
 }
 }  // namespace
 }  // namespace ember

@@ -17,6 +17,7 @@
 #include "accel/cone.h"
 #include "accel/cylinder.h"
 #include "accel/disc.h"
+#include "accel/quadric_lanes.h"
 #include "accel/sphere.h"
 #include "accel/triangle.h"
 #include "core/rng.h"
@@ -35,6 +36,7 @@
 #include "mc_mean.h"
 
 #include <array>
+#include <bit>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -728,9 +730,10 @@ TEST(ShapeQuad, KnownHitsInBothHalves) {
 }
 
 // An axis-aligned rectangle projects a hit point with the general plane's arithmetic specialised
-// to an axis normal: the same point and error bound as DoublePlane::project, for planes at zero,
-// at tiny and huge offsets, of either facing, and points near and far from them (where p[k] - c
-// is not exact, so that projecting is not simply p[k] = c).
+// to an axis normal: the same point, bit for bit up to the sign of a zero coordinate, and error
+// bound as DoublePlane::project, for planes at zero, at tiny and huge offsets, of either facing,
+// and points on, near and far from them (where p[k] - c is not exact, so that projecting is not
+// simply p[k] = c), with zero coordinates of either sign.
 TEST(ShapeQuad, AxisAlignedProjectionEqualsTheGeneralPlane) {
   Rng rng(5, 9);
   int compared = 0, notOnPlane = 0;
@@ -745,6 +748,8 @@ TEST(ShapeQuad, AxisAlignedProjectionEqualsTheGeneralPlane) {
         };
         std::array<Vec3, 4> v = {corner(-1, -2), corner(3, -2), corner(3, 4), corner(-1, 4)};
         if (flip) std::swap(v[1], v[3]);
+        ExactAxisRectangle rect;
+        ASSERT_TRUE(ExactAxisRectangle::of(v[0], v[1], v[2], v[3], rect));  // the specialised route
         const Quad quad(v, {Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)});
         const DoublePlane plane = DoublePlane::through(v[0], v[1], v[2]);
         for (int i = 0; i < 200; ++i) {
@@ -753,10 +758,16 @@ TEST(ShapeQuad, AxisAlignedProjectionEqualsTheGeneralPlane) {
           x[q] = 8.0f * rng.uniform() - 4.0f;
           const float scale = std::pow(10.0f, -30.0f + 40.0f * rng.uniform());
           x[axis] = c + (rng.uniform() - 0.5f) * std::max(std::abs(c) * 1e-6f, scale);
+          if (i % 10 == 0) x[p] = -0.0f;
+          if (i % 10 == 1) x[axis] = c;
+          if (i % 10 == 2) x[axis] = -0.0f;
           const SurfacePoint got = quad.projectToSurface(x, LocalHit{});
           const SurfacePoint want = plane.project(x);
-          ASSERT_TRUE(got.p == want.p && got.error == want.error)
-              << "axis " << axis << " c " << c << " point " << x.x << " " << x.y << " " << x.z;
+          bool same = got.error == want.error;
+          for (int k = 0; k < 3; ++k)  // + 0.0f: -0 becomes +0, every other value stays
+            same =
+                same && std::bit_cast<uint32_t>(got.p[k] + 0.0f) == std::bit_cast<uint32_t>(want.p[k] + 0.0f);
+          ASSERT_TRUE(same) << "axis " << axis << " c " << c << " point " << x.x << " " << x.y << " " << x.z;
           notOnPlane += got.p[axis] != c;
           ++compared;
         }
