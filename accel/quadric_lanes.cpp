@@ -154,9 +154,13 @@ uint32_t BoxCrossingsKernel(const RayLanes& rays, const ExactBox& box, uint32_t 
   return hits;
 }
 
-uint32_t AxisRectangleCrossingsKernel(const RayLanes& rays, const ExactAxisRectangle& rect, uint32_t lanes,
-                                      RectangleLanes& out) {
+// The rectangle's test for every lane of `rays`: live where `lanes` has a bit (kLiveFromValid:
+// where the ray is valid), with each lane's t also rounded to float into tFloat when given.
+template <bool kLiveFromValid>
+HWY_INLINE uint32_t axisRectangleLanes(const RayLanes& rays, const ExactAxisRectangle& rect, uint32_t lanes,
+                                       RectangleLanes& out, float* tFloat) {
   const D64 d;
+  const hn::Rebind<float, D64> df;
   const unsigned step = unsigned(hn::Lanes(d));
   const unsigned k = unsigned(rect.axis), ia = unsigned(rect.across[0]), ib = unsigned(rect.across[1]);
   const V64 c = hn::Set(d, rect.c), zero = hn::Zero(d);
@@ -164,7 +168,7 @@ uint32_t AxisRectangleCrossingsKernel(const RayLanes& rays, const ExactAxisRecta
   const V64 loB = hn::Set(d, rect.lo[1]), hiB = hn::Set(d, rect.hi[1]);
   uint32_t hits = 0;
   for (unsigned i = 0; i < rays.n; i += step) {
-    const M64 live = blockMask(d, lanes, i);
+    const M64 live = kLiveFromValid ? validMask(d, rays, i) : blockMask(d, lanes, i);
     if (hn::AllFalse(d, live)) continue;
     const V64 denom = loadPromoted(d, rays.dir[k], i);
     const V64 tHit = hn::Div(hn::Sub(c, loadPromoted(d, rays.org[k], i)), denom);
@@ -178,9 +182,20 @@ uint32_t AxisRectangleCrossingsKernel(const RayLanes& rays, const ExactAxisRecta
     hn::StoreU(tHit, d, out.t + i);
     hn::StoreU(a, d, out.a + i);
     hn::StoreU(b, d, out.b + i);
+    if (tFloat) hn::StoreU(hn::DemoteTo(df, tHit), df, tFloat + i);
     hits |= blockBits(d, hit, i);
   }
   return hits;
+}
+
+uint32_t AxisRectangleCrossingsKernel(const RayLanes& rays, const ExactAxisRectangle& rect, uint32_t lanes,
+                                      RectangleLanes& out) {
+  return axisRectangleLanes<false>(rays, rect, lanes, out, nullptr);
+}
+
+uint32_t AxisRectangleHitsKernel(const RayLanes& rays, const ExactAxisRectangle& rect, RectangleLanes& out,
+                                 float* t) {
+  return axisRectangleLanes<true>(rays, rect, 0, out, t);
 }
 
 }  // namespace ember::HWY_NAMESPACE
@@ -198,6 +213,7 @@ HWY_EXPORT(DiscCrossingsKernel);
 HWY_EXPORT(LateralRootsKernel);
 HWY_EXPORT(BoxCrossingsKernel);
 HWY_EXPORT(AxisRectangleCrossingsKernel);
+HWY_EXPORT(AxisRectangleHitsKernel);
 
 bool ExactDisc::cross(const Ray& ray, float tMin, float tMax, DiscCrossing& out) const {
   const glm::dvec3 o(ray.origin), dir(ray.dir);
@@ -338,6 +354,11 @@ bool ExactAxisRectangle::cross(const Ray& ray, float tMin, float tMax, Rectangle
 uint32_t axisRectangleCrossings(const RayLanes& rays, const ExactAxisRectangle& rect, uint32_t lanes,
                                 RectangleLanes& out) {
   return HWY_DYNAMIC_DISPATCH(AxisRectangleCrossingsKernel)(rays, rect, lanes, out);
+}
+
+uint32_t axisRectangleHits(const RayLanes& rays, const ExactAxisRectangle& rect, RectangleLanes& out,
+                           float* t) {
+  return HWY_DYNAMIC_DISPATCH(AxisRectangleHitsKernel)(rays, rect, out, t);
 }
 
 uint32_t discCrossings(const RayLanes& rays, const ExactDisc& disc, const float* tMax, uint32_t lanes,

@@ -112,5 +112,10 @@ struct RectangleLanes {
 };
 uint32_t axisRectangleCrossings(const RayLanes& rays, const ExactAxisRectangle& rect, uint32_t lanes,
                                 RectangleLanes& out);
+// axisRectangleCrossings of the rays' live lanes (valid), also writing each lane's t rounded to
+// float into t[0, rays.n): a quad's hits in one call, without a pass for the live lanes first nor
+// one converting the hits' t lane by lane.
+uint32_t axisRectangleHits(const RayLanes& rays, const ExactAxisRectangle& rect, RectangleLanes& out,
+                           float* t);
 
 }  // namespace ember

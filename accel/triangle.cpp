@@ -263,13 +263,14 @@ void Quad::intersectLanes(const RayLanes& rays, LaneHits& out) const {
     // Every live lane through the exact test at once: a ray that reaches an axis-aligned
     // rectangle's bounding box has crossed its plane within its bounds, so it nearly always hits.
     RectangleLanes crossings;
-    out.mask = axisRectangleCrossings(rays, exactRectangle_, Shape::candidateLanes(rays), crossings);
+    out.mask = axisRectangleHits(rays, exactRectangle_, crossings, out.t);
+    if (out.mask == 0) return;
     out.fillFlat(normal_);
-    for (uint32_t bits = out.mask; bits != 0; bits &= bits - 1) {
-      const unsigned i = unsigned(__builtin_ctz(bits));
-      out.t[i] = float(crossings.t[i]);
-      if (rays.needsUv) setUv(out, i, rectangleUv(crossings.a[i], crossings.b[i]));
-    }
+    if (rays.needsUv)
+      for (uint32_t bits = out.mask; bits != 0; bits &= bits - 1) {
+        const unsigned i = unsigned(__builtin_ctz(bits));
+        setUv(out, i, rectangleUv(crossings.a[i], crossings.b[i]));
+      }
     return;
   }
   out.mask = 0;

@@ -514,6 +514,21 @@ TEST(ShapeLanes, ExactAxisRectangleKernelEqualsTheScalarOnSpecialRays) {
     EXPECT_EQ(std::memcmp(&lanes.b[i], &crossing.b, sizeof(double)), 0);
   }
   EXPECT_GE(hits, 3);  // at least straight down, onto the edge and onto the corner
+  // The quad's route: the same crossings for the live lanes only (every third lane dead here),
+  // with each lane's t also rounded to float.
+  for (unsigned i = 0; i < n; i += 3) block.valid[i] = 0;
+  RectangleLanes liveLanes;
+  float t[RayLanes::kMaxLanes];
+  const uint32_t liveMask = axisRectangleHits(block.lanes(n), rect, liveLanes, t);
+  uint32_t expected = 0;
+  for (unsigned i = 0; i < n; ++i)
+    if (block.valid[i] != 0) expected |= mask & (1u << i);
+  EXPECT_EQ(liveMask, expected);
+  for (uint32_t bits = liveMask; bits != 0; bits &= bits - 1) {
+    const unsigned i = unsigned(__builtin_ctz(bits));
+    EXPECT_EQ(std::memcmp(&liveLanes.t[i], &lanes.t[i], sizeof(double)), 0) << "lane " << i;
+    EXPECT_EQ(t[i], float(lanes.t[i])) << "lane " << i;
+  }
   // The quad's hit is the rectangle's crossing.
   const Quad quad({v0, v1, v2, v3}, {Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)});
   LocalHit h;
