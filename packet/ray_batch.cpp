@@ -1,5 +1,7 @@
 #include "packet/ray_batch.h"
 
+#include "packet/traceable_lanes.h"
+
 #include <algorithm>
 #include <bit>
 #include <cstdlib>
@@ -16,17 +18,14 @@ constexpr size_t kFloatsPerRayHit = sizeof(RTCRayHit16) / (16 * sizeof(float));
 static_assert(sizeof(RTCRay8) == 8 * kFloatsPerRay * sizeof(float));
 static_assert(sizeof(RTCRayHit8) == 8 * kFloatsPerRayHit * sizeof(float));
 
-// An untraceable ray (accel/embree_accel.h) becomes an inactive lane at the origin with the
-// empty interval (1, 0): it misses, and as a shadow ray it is unblocked, as EmbreeAccel treats
-// single rays.
-void writeRay(RTCRayN* p, unsigned n, unsigned lane, const Ray& given) {
-  static const Ray inactive{Vec3(0.0f), Vec3(0.0f, 0.0f, 1.0f), 0.0f};
-  const bool ok = traceable(given);
-  const Ray& ray = ok ? given : inactive;
+// The ray's fields into lane `lane`, with the interval (0, ray.tMax). Rays Embree may not be given
+// (accel/embree_accel.h, traceable) are made inactive when the batch is traced
+// (packet/traceable_lanes.h).
+void writeRay(RTCRayN* p, unsigned n, unsigned lane, const Ray& ray) {
   RTCRayN_org_x(p, n, lane) = ray.origin.x;
   RTCRayN_org_y(p, n, lane) = ray.origin.y;
   RTCRayN_org_z(p, n, lane) = ray.origin.z;
-  RTCRayN_tnear(p, n, lane) = ok ? 0.0f : 1.0f;
+  RTCRayN_tnear(p, n, lane) = 0.0f;
   RTCRayN_dir_x(p, n, lane) = ray.dir.x;
   RTCRayN_dir_y(p, n, lane) = ray.dir.y;
   RTCRayN_dir_z(p, n, lane) = ray.dir.z;
@@ -125,6 +124,7 @@ void ClosestHitBatch::trace(const EmbreeAccel& accel, BatchTraversal traversal) 
   const size_t packets = storage_.packets(size_);
   auto* last = reinterpret_cast<RTCRayHitN*>(storage_.packet(packets - 1));
   disableLanes(RTCRayHitN_RayN(last, n), n, size_ - (packets - 1) * n);
+  disableUntraceableRays(storage_.packet(0), packets, n * kFloatsPerRayHit, n);
   if (traversal == BatchTraversal::Stream) {
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
     rtcIntersectNM(accel.rtcScene(), &context, reinterpret_cast<RTCRayHitN*>(storage_.packet(0)), n, packets,
@@ -170,6 +170,7 @@ void ShadowBatch::trace(const EmbreeAccel& accel, BatchTraversal traversal) {
   const unsigned n = storage_.width();
   const size_t packets = storage_.packets(size_);
   disableLanes(reinterpret_cast<RTCRayN*>(storage_.packet(packets - 1)), n, size_ - (packets - 1) * n);
+  disableUntraceableRays(storage_.packet(0), packets, n * kFloatsPerRay, n);
   if (traversal == BatchTraversal::Stream) {
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
     rtcOccludedNM(accel.rtcScene(), &context, reinterpret_cast<RTCRayN*>(storage_.packet(0)), n, packets,
