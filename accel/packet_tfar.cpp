@@ -14,7 +14,7 @@ namespace hn = hwy::HWY_NAMESPACE;
 
 using D = hn::CappedTag<float, kPacketTfarLanes>;
 
-void WidenLiveTfar(float* tfar, const int* valid, float* saved, unsigned n) {
+void WidenedTfar(const float* tfar, const int* valid, float* widened, unsigned n) {
   const D d;
   const hn::RebindToSigned<D> di;
   const auto infinity = hn::Set(d, std::numeric_limits<float>::infinity());
@@ -22,29 +22,12 @@ void WidenLiveTfar(float* tfar, const int* valid, float* saved, unsigned n) {
   unsigned i = 0;
   for (; i + step <= n; i += step) {
     const auto t = hn::LoadU(d, tfar + i);
-    hn::StoreU(t, d, saved + i);
     const auto live = hn::RebindMask(d, hn::Ne(hn::LoadU(di, valid + i), hn::Zero(di)));
     // The next float up of a positive float is its bit pattern plus one.
     const auto up = hn::BitCast(d, hn::Add(hn::BitCast(di, t), hn::Set(di, 1)));
-    hn::StoreU(hn::IfThenElse(hn::And(live, hn::Lt(t, infinity)), up, t), d, tfar + i);
+    hn::StoreU(hn::IfThenElse(hn::And(live, hn::Lt(t, infinity)), up, t), d, widened + i);
   }
-  for (; i < n; ++i) {
-    saved[i] = tfar[i];
-    if (valid[i]) tfar[i] = nextFloatUp(tfar[i]);
-  }
-}
-
-void StoreLiveTfar(float* tfar, const int* valid, const float* result, unsigned n) {
-  const D d;
-  const hn::RebindToSigned<D> di;
-  const unsigned step = unsigned(hn::Lanes(d));
-  unsigned i = 0;
-  for (; i + step <= n; i += step) {
-    const auto live = hn::RebindMask(d, hn::Ne(hn::LoadU(di, valid + i), hn::Zero(di)));
-    hn::StoreU(hn::IfThenElse(live, hn::LoadU(d, result + i), hn::LoadU(d, tfar + i)), d, tfar + i);
-  }
-  for (; i < n; ++i)
-    if (valid[i]) tfar[i] = result[i];
+  for (; i < n; ++i) widened[i] = valid[i] ? nextFloatUp(tfar[i]) : tfar[i];
 }
 
 }  // namespace ember::HWY_NAMESPACE
@@ -53,15 +36,10 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 namespace ember {
 
-HWY_EXPORT(WidenLiveTfar);
-HWY_EXPORT(StoreLiveTfar);
+HWY_EXPORT(WidenedTfar);
 
-void widenLiveTfar(float* tfar, const int* valid, float* saved, unsigned n) {
-  HWY_DYNAMIC_DISPATCH(WidenLiveTfar)(tfar, valid, saved, n);
-}
-
-void storeLiveTfar(float* tfar, const int* valid, const float* result, unsigned n) {
-  HWY_DYNAMIC_DISPATCH(StoreLiveTfar)(tfar, valid, result, n);
+void widenedTfar(const float* tfar, const int* valid, float* widened, unsigned n) {
+  HWY_DYNAMIC_DISPATCH(WidenedTfar)(tfar, valid, widened, n);
 }
 
 }  // namespace ember

@@ -1,10 +1,11 @@
-// The intersect callback's two passes over a packet's tfar (accel/user_geometry.cpp), as vectors.
-// Embree writes a packet's tfar with vector stores, and the lane filters read it with vector
-// loads; the callback's lane-by-lane loads and stores between them made each vector load wait on
-// narrow stores it could not forward from (`perf annotate`: most of the callback's 10% of a
-// render). Each function does, lane for lane, what the scalar loop it replaces did: whole vectors
-// first, then the lanes past the last whole vector one by one (a single ray, or an 8-ray packet
-// on a CPU whose vectors hold 16 floats).
+// The tfar the intersect callback shows the shapes (accel/user_geometry.cpp): each live ray's
+// tfar one float step up, as a vector pass into the callback's own array. The shapes read it in
+// place of the packet's tfar, and the callback commits their hits into the packet's, which is
+// never widened and so needs no pass restoring it. (Widened in Embree's arrays and restored after
+// the shapes, the two passes cost a dispatch and a copy per callback; done lane by lane, their
+// narrow stores made the filters' vector loads wait, `perf annotate`: most of the callback's 10%
+// of a render.) The lanes past the last whole vector (a single ray, or an 8-ray packet on a CPU
+// whose vectors hold 16 floats) are done one by one.
 #pragma once
 
 #include <bit>
@@ -23,11 +24,8 @@ inline float nextFloatUp(float x) {
                                                     : x;
 }
 
-// For lanes [0, n), n <= kPacketTfarLanes: saved[i] = tfar[i]; then each live lane's
-// (valid[i] != 0) tfar moves one float up, except +infinity, which stays.
-void widenLiveTfar(float* tfar, const int* valid, float* saved, unsigned n);
-
-// For lanes [0, n): tfar[i] = result[i] for each live lane; the others keep theirs.
-void storeLiveTfar(float* tfar, const int* valid, const float* result, unsigned n);
+// For lanes [0, n), n <= kPacketTfarLanes: widened[i] is the next float above tfar[i] for each
+// live lane (valid[i] != 0; +infinity stays), and tfar[i] for the others.
+void widenedTfar(const float* tfar, const int* valid, float* widened, unsigned n);
 
 }  // namespace ember

@@ -33,8 +33,9 @@ void shapeBoundsCallback(const RTCBoundsFunctionArguments* args) {
 // rays' finite values, never live.
 class PacketLanes {
  public:
-  PacketLanes(RTCRayN* rays, unsigned n, const int* valid, bool needsUv)
-      : f_(reinterpret_cast<float*>(rays)), n_(n), valid_(valid), needsUv_(needsUv) {}
+  // The shapes see `tfar` (n floats) as the rays' tfar.
+  PacketLanes(RTCRayN* rays, const float* tfar, unsigned n, const int* valid, bool needsUv)
+      : f_(reinterpret_cast<float*>(rays)), tfar_(tfar), n_(n), valid_(valid), needsUv_(needsUv) {}
 
   unsigned blocks() const { return (n_ + RayLanes::kMaxLanes - 1) / RayLanes::kMaxLanes; }
   RayLanes block(unsigned k) {
@@ -45,7 +46,7 @@ class PacketLanes {
       return RayLanes{{field(0), field(1), field(2)},
                       {field(4), field(5), field(6)},
                       field(3),
-                      field(8),
+                      tfar_ + first,
                       valid_ + first,
                       count,
                       needsUv_};
@@ -57,7 +58,7 @@ class PacketLanes {
         pad.dir[c][i] = f_[(4 + c) * n_ + first + i];
       }
       pad.tnear[i] = f_[3 * n_ + first + i];
-      pad.tfar[i] = f_[8 * n_ + first + i];
+      pad.tfar[i] = tfar_[first + i];
     }
     for (unsigned i = 0; i < RayLanes::kMaxLanes; ++i) pad.valid[i] = i < count ? valid_[first + i] : 0;
     return RayLanes{{pad.org[0], pad.org[1], pad.org[2]},
@@ -82,6 +83,7 @@ class PacketLanes {
     return pad;
   }
   float* f_;
+  const float* tfar_;
   unsigned n_;
   const int* valid_;
   bool needsUv_;
@@ -91,9 +93,9 @@ class PacketLanes {
 // with the block's hits, as the shape's intersectLanes decides them. Single rays take the same
 // route (a padded block of one live lane), so a packet finds exactly the hits single rays find.
 template <typename Report>
-void intersectPacket(const Shape& shape, bool needsUv, RTCRayN* rays, unsigned n, const int* valid,
-                     Report report) {
-  PacketLanes packet(rays, n, valid, needsUv);
+void intersectPacket(const Shape& shape, bool needsUv, RTCRayN* rays, const float* tfar, unsigned n,
+                     const int* valid, Report report) {
+  PacketLanes packet(rays, tfar, n, valid, needsUv);
   thread_local LaneHits hits;  // the thread's own: a block's hit arrays, not rebuilt per call
   for (unsigned k = 0; k < packet.blocks(); ++k) {
     const RayLanes block = packet.block(k);
@@ -113,23 +115,22 @@ void shapeIntersectCallback(const RTCIntersectFunctionNArguments* args) {
   // t rounds onto the current tfar would be kept by the shape Embree happens to visit first, and
   // Embree visits them in another order for single rays than for packets. So the shapes see tfar
   // one float step further, and every hit that rounds onto tfar reaches the rule below.
-  float tfar[kPacketTfarLanes];
+  float widened[kPacketTfarLanes];
   float* rayTfar = &RTCRayN_tfar(rays, n, 0);
-  widenLiveTfar(rayTfar, args->valid, tfar, n);
+  widenedTfar(rayTfar, args->valid, widened, n);
   // A hit at exactly the current tfar ties with the hit found there: the smaller geomID keeps it
   // (commitLaneHits), so that the result does not depend on the order Embree visits the shapes in.
-  intersectPacket(*geometry->shape, geometry->needsUv, rays, n, args->valid,
+  intersectPacket(*geometry->shape, geometry->needsUv, rays, widened, n, args->valid,
                   [&](unsigned first, unsigned count, const LaneHits& found) {
-                    commitLaneHits(found, count, tfar + first, hits, n, first, args->primID, args->geomID,
+                    commitLaneHits(found, count, rayTfar + first, hits, n, first, args->primID, args->geomID,
                                    args->context->instID[0]);
                   });
-  storeLiveTfar(rayTfar, args->valid, tfar, n);
 }
 
 void shapeOccludedCallback(const RTCOccludedFunctionNArguments* args) {
   const auto* shape = static_cast<const ShapeGeometry*>(args->geometryUserPtr)->shape;
   // Embree 3 reports an occluded ray by setting tfar to -infinity.
-  intersectPacket(*shape, false, args->ray, args->N, args->valid,
+  intersectPacket(*shape, false, args->ray, &RTCRayN_tfar(args->ray, args->N, 0), args->N, args->valid,
                   [&](unsigned first, unsigned, const LaneHits& found) {
                     for (uint32_t bits = found.mask; bits != 0; bits &= bits - 1)
                       RTCRayN_tfar(args->ray, args->N, first + unsigned(__builtin_ctz(bits))) = -kInfinity;
