@@ -6,7 +6,8 @@
 #include "packet/traceable_lanes.h"
 
 #include <gtest/gtest.h>
-#include <hwy/targets.h>
+
+#include "simd_targets.h"
 
 #include <bit>
 #include <cstdint>
@@ -35,16 +36,7 @@ float coordinate(Rng& rng) {
 }
 
 TEST(RayBatch, UntraceableLanesEqualTheScalarCheckOnEveryTarget) {
-  struct RestoreTargets {
-    ~RestoreTargets() {
-      hwy::SetSupportedTargetsForTest(0);
-      hwy::GetChosenTarget().Update(hwy::SupportedTargets());
-    }
-  } restore;
-  for (const int64_t target : hwy::SupportedAndGeneratedTargets()) {
-    SCOPED_TRACE(hwy::TargetName(target));
-    hwy::SetSupportedTargetsForTest(target);
-    hwy::GetChosenTarget().Update(hwy::SupportedTargets());
+  forEachSimdTarget([] {
     for (const unsigned width : {8u, 16u}) {
       SCOPED_TRACE(width);
       Rng rng(width, 7);
@@ -91,7 +83,7 @@ TEST(RayBatch, UntraceableLanesEqualTheScalarCheckOnEveryTarget) {
       EXPECT_GT(untraceable, 50);
       EXPECT_LT(untraceable, int(kPackets * width) - 50);
     }
-  }
+  });
 }
 
 }  // namespace

@@ -23,6 +23,8 @@
 #include <gtest/gtest.h>
 #include <hwy/targets.h>
 
+#include "simd_targets.h"
+
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -720,39 +722,69 @@ TEST(ShapeLanes, DegenerateDirectionsGetTheScalarResult) {
   }
 }
 
-TEST(PacketTfar, VectorPassEqualsTheScalarLoop) {
-  Rng rng(7, 1);
-  const float special[] = {kInfinity,
-                           0.0f,
-                           -1.0f,
-                           1e-30f,
-                           std::numeric_limits<float>::max(),
-                           3.5f,
-                           std::numeric_limits<float>::quiet_NaN(),
-                           -kInfinity,
-                           -0.0f,
-                           std::numeric_limits<float>::denorm_min()};
-  for (const unsigned n : {16u, 8u, 4u, 1u, 13u, 7u}) {
-    for (int trial = 0; trial < 200; ++trial) {
-      // The pass reads tfar only, and writes no widened lane past n.
-      alignas(64) float tfar[kPacketTfarLanes], expected[kPacketTfarLanes];
-      alignas(64) int valid[kPacketTfarLanes];
-      for (unsigned i = 0; i < kPacketTfarLanes; ++i) {
-        tfar[i] = i >= n                 ? -7.0f
-                  : rng.uniform() < 0.3f ? special[rng.nextU32() % 10]
-                                         : 100.0f * rng.uniform();
-        valid[i] = rng.uniform() < 0.5f ? -1 : 0;
+TEST(PacketTfar, VectorPassEqualsTheScalarLoopOnEveryTarget) {
+  forEachSimdTarget([] {
+    Rng rng(7, 1);
+    const float special[] = {kInfinity,
+                             0.0f,
+                             -1.0f,
+                             1e-30f,
+                             std::numeric_limits<float>::max(),
+                             3.5f,
+                             std::numeric_limits<float>::quiet_NaN(),
+                             -kInfinity,
+                             -0.0f,
+                             std::numeric_limits<float>::denorm_min()};
+    for (const unsigned n : {16u, 8u, 4u, 1u, 13u, 7u}) {
+      for (int trial = 0; trial < 200; ++trial) {
+        // The pass reads tfar only, and writes no widened lane past n.
+        alignas(64) float tfar[kPacketTfarLanes], expected[kPacketTfarLanes];
+        alignas(64) int valid[kPacketTfarLanes];
+        for (unsigned i = 0; i < kPacketTfarLanes; ++i) {
+          tfar[i] = i >= n                 ? -7.0f
+                    : rng.uniform() < 0.3f ? special[rng.nextU32() % 10]
+                                           : 100.0f * rng.uniform();
+          valid[i] = rng.uniform() < 0.5f ? -1 : 0;
+        }
+        float widened[kPacketTfarLanes], widenedExpected[kPacketTfarLanes];
+        std::fill(widened, widened + kPacketTfarLanes, -9.0f);
+        std::fill(widenedExpected, widenedExpected + kPacketTfarLanes, -9.0f);
+        std::memcpy(expected, tfar, sizeof(tfar));
+        for (unsigned i = 0; i < n; ++i) widenedExpected[i] = valid[i] ? nextFloatUp(tfar[i]) : tfar[i];
+        widenedTfar(tfar, valid, widened, n);
+        ASSERT_EQ(0, std::memcmp(widened, widenedExpected, sizeof(widened)))
+            << "n " << n << " trial " << trial;
+        ASSERT_EQ(0, std::memcmp(tfar, expected, sizeof(tfar))) << "n " << n << " trial " << trial;
       }
-      float widened[kPacketTfarLanes], widenedExpected[kPacketTfarLanes];
-      std::fill(widened, widened + kPacketTfarLanes, -9.0f);
-      std::fill(widenedExpected, widenedExpected + kPacketTfarLanes, -9.0f);
-      std::memcpy(expected, tfar, sizeof(tfar));
-      for (unsigned i = 0; i < n; ++i) widenedExpected[i] = valid[i] ? nextFloatUp(tfar[i]) : tfar[i];
-      widenedTfar(tfar, valid, widened, n);
-      ASSERT_EQ(0, std::memcmp(widened, widenedExpected, sizeof(widened))) << "n " << n << " trial " << trial;
-      ASSERT_EQ(0, std::memcmp(tfar, expected, sizeof(tfar))) << "n " << n << " trial " << trial;
     }
-  }
+  });
+}
+
+// The live lanes of a block (liveLanes: valid and below n; the rectangle's validMask inside its
+// kernel) on every target, for blocks of every length with live and dead lanes (-1 and 0, as
+// Embree marks them) on both sides of n.
+TEST(ShapeLanes, LiveLanesOnEveryTarget) {
+  forEachSimdTarget([] {
+    Rng rng(5, 9);
+    const Vec3 v0(-1.0f, 0.5f, -0.5f), v1(1.0f, 0.5f, -0.5f), v2(1.0f, 0.5f, 0.5f), v3(-1.0f, 0.5f, 0.5f);
+    ExactAxisRectangle rect;
+    ASSERT_TRUE(ExactAxisRectangle::of(v0, v1, v2, v3, rect));
+    for (unsigned n = 1; n <= RayLanes::kMaxLanes; ++n)
+      for (int trial = 0; trial < 50; ++trial) {
+        Block block;
+        uint32_t expected = 0;
+        for (unsigned i = 0; i < RayLanes::kMaxLanes; ++i) {
+          // Straight down onto the rectangle: every live lane hits it.
+          const Ray ray{Vec3(rng.uniform() - 0.5f, 2.0f, rng.uniform() - 0.5f), Vec3(0.0f, -1.0f, 0.0f)};
+          block.set(i, ray, rng.uniform() < 0.6f);
+          if (i < n && block.valid[i] != 0) expected |= 1u << i;
+        }
+        ASSERT_EQ(liveLanes(block.lanes(n)), expected) << "n " << n;
+        RectangleLanes crossings;
+        float t[RayLanes::kMaxLanes];
+        ASSERT_EQ(axisRectangleHits(block.lanes(n), rect, crossings, t), expected) << "n " << n;
+      }
+  });
 }
 
 // The callback's vector commit against the scalar rule it replaced, lane by lane: ties at tfar
@@ -762,19 +794,7 @@ TEST(PacketTfar, VectorPassEqualsTheScalarLoop) {
 // ignored, and the packet's other lanes untouched. On every SIMD target the CPU and the build have
 // (AVX-512, AVX2, SSE4, ...: 8, 8 and 4 lanes a step), not only the one dispatch picks.
 TEST(PacketCommit, VectorCommitEqualsTheScalarRule) {
-  // Each target in turn, then back to the CPU's best, also when an assertion returns early.
-  struct RestoreTargets {
-    ~RestoreTargets() {
-      hwy::SetSupportedTargetsForTest(0);
-      hwy::GetChosenTarget().Update(hwy::SupportedTargets());
-    }
-  } restore;
-  const std::vector<int64_t> targets = hwy::SupportedAndGeneratedTargets();
-  ASSERT_FALSE(targets.empty());
-  for (const int64_t target : targets) {
-    SCOPED_TRACE(hwy::TargetName(target));
-    hwy::SetSupportedTargetsForTest(target);
-    hwy::GetChosenTarget().Update(hwy::SupportedTargets());
+  forEachSimdTarget([] {
     Rng rng(11, 3);
     constexpr unsigned kLanes = RayLanes::kMaxLanes;
     const float special[] = {kInfinity, 0.0f, -0.0f, 2.0f, std::numeric_limits<float>::quiet_NaN(), 1e-30f};
@@ -838,7 +858,7 @@ TEST(PacketCommit, VectorCommitEqualsTheScalarRule) {
     }
     EXPECT_GT(kept, 2000);
     EXPECT_GT(ties, 600);
-  }
+  });
 }
 }  // namespace
 }  // namespace ember
