@@ -45,6 +45,7 @@ bool Sphere::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) co
 
 void Sphere::intersectLanes(const RayLanes& rays, LaneHits& out) const {
   out.mask = sphereHits(rays, center_, radius_, candidateLanes(rays), out);
+  if (out.mask == 0) return;  // the callback reads nothing of a block without hits
   for (auto& row : out.uv) std::fill(std::begin(row), std::end(row), 0.0f);  // surfaceUv derives it
 }
 

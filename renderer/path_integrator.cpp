@@ -100,20 +100,22 @@ bool PathIntegrator::arrive(const Scene& scene, PathState& path, const SurfaceHi
     if (isBlack(path.throughput)) return false;
   }
 
-  const LightSampler& lights = scene.lightSampler();
-  const Color emitted = hit.emitted(wo);
-  // Emission after a Dirac bounce, on a path whose first bounce was not one, is a caustic the
-  // light tracer estimates (renderer/caustic_tracer.h): counting it here too would count it twice.
-  const bool caustic = traceCaustics_ && path.previousDelta && path.firstBounceNonDelta && hit.light &&
-                       hit.light->causticTraced;
-  if (!isBlack(emitted) && !caustic) {
-    float weight = 1.0f;
-    if (!path.previousDelta) {
-      const float lightPdf =
-          hit.light ? lights.pmf(hit.light) * hit.light->pdf(path.previousPoint, hit.p, hit.ng) : 0.0f;
-      weight = emissionWeight(path.previousPdf, lightPdf);
+  if (!isBlack(hit.emission)) {  // most vertices emit nothing: then there is nothing to weigh
+    const Color emitted = hit.emitted(wo);
+    // Emission after a Dirac bounce, on a path whose first bounce was not one, is a caustic the
+    // light tracer estimates (renderer/caustic_tracer.h): counting it here too would count it twice.
+    const bool caustic = traceCaustics_ && path.previousDelta && path.firstBounceNonDelta && hit.light &&
+                         hit.light->causticTraced;
+    if (!isBlack(emitted) && !caustic) {
+      float weight = 1.0f;
+      if (!path.previousDelta) {
+        const LightSampler& lights = scene.lightSampler();
+        const float lightPdf =
+            hit.light ? lights.pmf(hit.light) * hit.light->pdf(path.previousPoint, hit.p, hit.ng) : 0.0f;
+        weight = emissionWeight(path.previousPdf, lightPdf);
+      }
+      path.radiance += path.throughput * emitted * weight;
     }
-    path.radiance += path.throughput * emitted * weight;
   }
 
   return !(maxDepth_ >= 0 && path.depth >= maxDepth_) && hit.material;
