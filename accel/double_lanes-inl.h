@@ -45,14 +45,15 @@ HWY_INLINE V64 loadPromoted(D64 d, const float* p, unsigned i) {
   return hn::PromoteTo(d, hn::LoadU(df, p + i));
 }
 
-// The live lanes of the block starting at lane i (valid != 0, below rays.n), as a mask. Reads
+// The live lanes of the block starting at lane i (valid == -1, below rays.n: liveLanes' rule in
+// accel/shape_lanes.cpp, which the quad's route used before), as a mask. Reads
 // Lanes(d) entries of rays.valid: a block's arrays hold whole double vectors (accel/user_geometry.cpp
 // copies a block into padded arrays unless its length is a multiple of the float vectors').
 HWY_INLINE M64 validMask(D64 d, const RayLanes& rays, unsigned i) {
   const hn::RebindToSigned<D64> di;
   const hn::Rebind<int32_t, D64> di32;
   const auto valid = hn::PromoteTo(di, hn::LoadU(di32, rays.valid + i));
-  return hn::RebindMask(d, hn::And(hn::Ne(valid, hn::Zero(di)), hn::FirstN(di, rays.n - i)));
+  return hn::RebindMask(d, hn::And(hn::Eq(valid, hn::Set(di, -1)), hn::FirstN(di, rays.n - i)));
 }
 
 // The bits of `lanes` for the block starting at lane i, as a mask.

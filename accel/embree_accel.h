@@ -28,17 +28,19 @@ struct RawHit {
   Vec3 ng;  // unnormalised for meshes; for shapes, the shape's unit normal
 };
 
+// Embree's FLT_LARGE: the largest coordinate magnitude it accepts.
+inline constexpr float kEmbreeLarge = 1.844e18f;
+
 // Whether Embree may be given the ray: every origin and direction coordinate within Embree's
 // FLT_LARGE (1.8e18) and a non-NaN interval, as its RayK::valid() requires (Debian builds Embree
 // with assertions, which abort on anything else). Rays that are not traceable miss everything:
 // they come from degenerate input (a camera at infinity, coordinates near FLT_MAX), and the
 // paths they belong to give non-finite samples, which the film drops.
 inline bool traceable(const Ray& ray) {
-  constexpr float kLarge = 1.844e18f;
   // Every component compared on its own: std::max drops a NaN in all but its first argument, and
   // a NaN compares false, so it is untraceable wherever it is.
-  const glm::bvec3 originOk = glm::lessThanEqual(absolute(ray.origin), Vec3(kLarge));
-  const glm::bvec3 dirOk = glm::lessThanEqual(absolute(ray.dir), Vec3(kLarge));
+  const glm::bvec3 originOk = glm::lessThanEqual(absolute(ray.origin), Vec3(kEmbreeLarge));
+  const glm::bvec3 dirOk = glm::lessThanEqual(absolute(ray.dir), Vec3(kEmbreeLarge));
   return glm::all(originOk) && glm::all(dirOk) && !std::isnan(ray.tMax);
 }
 

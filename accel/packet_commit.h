@@ -19,8 +19,9 @@ namespace ember {
 // depend on the order Embree visits the shapes in; a lane without a hit has tfar at its ray's
 // open end). A kept hit sets tfar[i] = hits.t[i] and writes its normal, uv and the IDs into
 // lane first + i of `packet`, Embree's hit arrays of a packet of `width` rays (first + n <=
-// width). tfar holds the block's lanes [0, n) (the callback's widened tfar, offset to the block's
-// first lane); n <= kMaxLanes, and mask bits at or past n are ignored.
+// width). tfar holds the block's lanes [0, n) (the packet's own tfar, offset to the block's first
+// lane, not the widened copy the shapes saw); n <= kMaxLanes, and mask bits at or past n are
+// ignored.
 void commitLaneHits(const LaneHits& hits, unsigned n, float* tfar, RTCHitN* packet, unsigned width,
                     unsigned first, uint32_t primID, uint32_t geomID, uint32_t instID);
 

@@ -6,6 +6,8 @@
 
 #include "packet/traceable_lanes.h"
 
+#include "accel/embree_accel.h"
+
 HWY_BEFORE_NAMESPACE();
 namespace ember::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
@@ -16,8 +18,8 @@ enum Field { kOrgX, kOrgY, kOrgZ, kTnear, kDirX, kDirY, kDirZ, kTime, kTfar };
 // Vectors of at most `width` floats (D's cap), so that none reaches into the next field.
 template <class D>
 HWY_INLINE void disableInPackets(D d, float* first, size_t packets, size_t stride, unsigned width) {
-  // Embree's FLT_LARGE, as accel/embree_accel.h's traceable() compares each coordinate with it.
-  const auto large = hn::Set(d, 1.844e18f);
+  // As accel/embree_accel.h's traceable() compares each coordinate with it.
+  const auto large = hn::Set(d, kEmbreeLarge);
   const auto zero = hn::Zero(d), one = hn::Set(d, 1.0f);
   const unsigned step = unsigned(hn::Lanes(d));
   for (size_t k = 0; k < packets; ++k) {

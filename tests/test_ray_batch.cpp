@@ -24,9 +24,9 @@ float coordinate(Rng& rng) {
                            -std::numeric_limits<float>::quiet_NaN(),
                            std::numeric_limits<float>::infinity(),
                            -std::numeric_limits<float>::infinity(),
-                           1.844e18f,  // Embree's FLT_LARGE: still traceable
-                           std::nextafter(1.844e18f, 1e30f),
-                           -1.844e18f,
+                           kEmbreeLarge,  // still traceable
+                           std::nextafter(kEmbreeLarge, 1e30f),
+                           -kEmbreeLarge,
                            2e18f,
                            -0.0f,
                            0.0f,

@@ -760,9 +760,9 @@ TEST(PacketTfar, VectorPassEqualsTheScalarLoopOnEveryTarget) {
   });
 }
 
-// The live lanes of a block (liveLanes: valid and below n; the rectangle's validMask inside its
-// kernel) on every target, for blocks of every length with live and dead lanes (-1 and 0, as
-// Embree marks them) on both sides of n.
+// The live lanes of a block (liveLanes: valid == -1 and below n; the rectangle's validMask inside
+// its kernel, the same rule) on every target, for blocks of every length with live and dead lanes (-1 and 0,
+// as Embree marks them) on both sides of n.
 TEST(ShapeLanes, LiveLanesOnEveryTarget) {
   forEachSimdTarget([] {
     Rng rng(5, 9);
