@@ -42,10 +42,10 @@ class PacketLanes {
     const unsigned first = k * RayLanes::kMaxLanes;
     const unsigned count = std::min(RayLanes::kMaxLanes, n_ - first);
     if (count == RayLanes::kMaxLanes || count % rayLanesStep() == 0) {
-      auto field = [&](unsigned i) { return f_ + i * n_ + first; };
-      return RayLanes{{field(0), field(1), field(2)},
-                      {field(4), field(5), field(6)},
-                      field(3),
+      const float* org = f_ + first;  // RTCRayN's fields follow each other, n_ floats apart
+      return RayLanes{{org, org + n_, org + 2 * n_},
+                      {org + 4 * n_, org + 5 * n_, org + 6 * n_},
+                      org + 3 * n_,
                       tfar_ + first,
                       valid_ + first,
                       count,

@@ -27,6 +27,7 @@ class AliasTable {
   // A u outside [0, 1), or NaN, still gives an outcome: below 0 it counts as 0, at 1 and above
   // as the last bin.
   size_t sample(float u) const {
+    if (bins_.size() == 1) return 0;  // a scene of one light: nothing to choose
     const double scaled = (u > 0.0f ? double(u) : 0.0) * double(bins_.size());
     const size_t bin = std::min(size_t(scaled), bins_.size() - 1);
     const Bin& b = bins_[bin];

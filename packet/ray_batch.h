@@ -76,6 +76,10 @@ class ClosestHitBatch {
   uint32_t geometryOf(size_t i) const {
     return RTCHitN_geomID(hitsOf(i), storage_.width(), storage_.laneOf(i));
   }
+  // The primID of ray i's hit; meaningless for a miss.
+  uint32_t primitiveOf(size_t i) const {
+    return RTCHitN_primID(hitsOf(i), storage_.width(), storage_.laneOf(i));
+  }
 
  private:
   RTCRayHitN* packetOf(size_t i) const { return reinterpret_cast<RTCRayHitN*>(storage_.packetOf(i)); }

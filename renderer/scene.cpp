@@ -86,6 +86,7 @@ void Scene::build() {
       }
     }
     records_[id] = rec;
+    hasMeshes_ = true;
   }
   accel_->commit();
   bounds_ = accel_->bounds();
@@ -169,6 +170,27 @@ void Scene::surfaceHit(const Ray& ray, const RawHit& raw, SurfaceHit& hit) const
   hit.twoSidedEmission = rec.twoSidedEmission;
   if (rec.maps && rec.maps->emission && !isBlack(rec.emission))
     hit.emission *= rec.maps->emission->eval(hit.uv);
+}
+
+void Scene::prefetchTriangle(uint32_t geomID, uint32_t primID) const {
+  const GeometryRecord& rec = records_[geomID];
+  if (!rec.mesh) return;
+  __builtin_prefetch(&rec.mesh->indices[primID]);
+  if (rec.firstTriangleLight >= 0)
+    __builtin_prefetch(&triangleLights_[size_t(rec.firstTriangleLight) + primID]);
+}
+
+void Scene::prefetchVertices(uint32_t geomID, uint32_t primID) const {
+  const TriangleMesh* mesh = records_[geomID].mesh;
+  if (!mesh) return;
+  const glm::uvec3& idx = mesh->indices[primID];
+  // What surfaceHit reads of each vertex (TriangleMesh::pointAt, pointError and surfaceAt).
+  for (const uint32_t v : {idx.x, idx.y, idx.z}) {
+    __builtin_prefetch(&mesh->positions[v]);
+    if (!mesh->normals.empty()) __builtin_prefetch(&mesh->normals[v]);
+    if (!mesh->uvs.empty()) __builtin_prefetch(&mesh->uvs[v]);
+    if (!mesh->tangents.empty()) __builtin_prefetch(&mesh->tangents[v]);
+  }
 }
 
 bool Scene::occluded(const Ray& ray) const {

@@ -82,6 +82,14 @@ class Scene {
   void surfaceHit(const Ray& ray, const RawHit& raw, SurfaceHit& hit) const;
   // Geometries in the acceleration structure: every geomID is below this.
   size_t geometryCount() const { return records_.size(); }
+  // Hints for loops that settle many hits (packet/wavefront_integrator.cpp): on a large mesh,
+  // surfaceHit's loads of a triangle's indices and then of its vertices miss every cache. These
+  // start them early, in two steps, as the vertices' addresses are in the indices: first
+  // prefetchTriangle, then, some hits later, prefetchVertices (which reads the indices). Both do
+  // nothing for analytic shapes; hasMeshes() says whether they can do anything at all.
+  bool hasMeshes() const { return hasMeshes_; }
+  void prefetchTriangle(uint32_t geomID, uint32_t primID) const;
+  void prefetchVertices(uint32_t geomID, uint32_t primID) const;
   // True when something blocks the ray before ray.tMax (a shadow ray from core/ray_spawn.h).
   bool occluded(const Ray& ray) const;
 
@@ -121,6 +129,7 @@ class Scene {
   const EnvironmentLight* environment_ = nullptr;
   CausticTracer causticTracer_;
   Bounds bounds_;
+  bool hasMeshes_ = false;
 };
 
 }  // namespace ember
