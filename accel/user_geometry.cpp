@@ -42,10 +42,10 @@ class PacketLanes {
     const unsigned first = k * RayLanes::kMaxLanes;
     const unsigned count = std::min(RayLanes::kMaxLanes, n_ - first);
     if (count == RayLanes::kMaxLanes || count % rayLanesStep() == 0) {
-      const float* org = f_ + first;  // RTCRayN's fields follow each other, n_ floats apart
-      return RayLanes{{org, org + n_, org + 2 * n_},
-                      {org + 4 * n_, org + 5 * n_, org + 6 * n_},
-                      org + 3 * n_,
+      const float* base = f_ + first;  // field i of the block: base + i * n_
+      return RayLanes{{base, base + n_, base + 2 * n_},
+                      {base + 4 * n_, base + 5 * n_, base + 6 * n_},
+                      base + 3 * n_,
                       tfar_ + first,
                       valid_ + first,
                       count,

@@ -27,9 +27,11 @@ class AliasTable {
   // A u outside [0, 1), or NaN, still gives an outcome: below 0 it counts as 0, at 1 and above
   // as the last bin.
   size_t sample(float u) const {
-    if (bins_.size() == 1) return 0;  // a scene of one light: nothing to choose
-    const double scaled = (u > 0.0f ? double(u) : 0.0) * double(bins_.size());
-    const size_t bin = std::min(size_t(scaled), bins_.size() - 1);
+    const size_t n = bins_.size();
+    if (n == 1) return 0;  // one outcome: nothing to draw
+    const double scaled = (u > 0.0f ? double(u) : 0.0) * double(n);
+    // Compared before the conversion, which is undefined for a u of +infinity.
+    const size_t bin = scaled < double(n) ? size_t(scaled) : n - 1;
     const Bin& b = bins_[bin];
     return scaled - double(bin) < double(b.threshold) ? bin : b.alias;
   }

@@ -3,6 +3,7 @@
 #include "materials/material.h"
 #include "packet/bsdf_batch.h"
 #include "packet/geometry_groups.h"
+#include "packet/hit_prefetch.h"
 #include "renderer/sampler_lanes.h"
 #include "renderer/scene.h"
 
@@ -109,7 +110,9 @@ void traceCausticsInWaves(const Scene& scene, int maxDepth, int rrDepth, uint64_
           wave.shadows.clear();
           wave.groups.group(wave.closest, active, scene.geometryCount());
           size_t vertices = 0;
+          const bool prefetch = scene.prefetchesMeshHits();
           for (size_t o = 0; o < active; ++o) {
+            if (prefetch) prefetchGroupedHits(scene, wave.closest, wave.groups, o, active);
             const size_t a = wave.groups.order()[o];
             LightWave::Lane& lane = wave.lanes[wave.active[a]];
             RawHit raw;

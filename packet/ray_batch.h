@@ -76,7 +76,7 @@ class ClosestHitBatch {
   uint32_t geometryOf(size_t i) const {
     return RTCHitN_geomID(hitsOf(i), storage_.width(), storage_.laneOf(i));
   }
-  // The primID of ray i's hit; meaningless for a miss.
+  // The primID of ray i's hit, RTC_INVALID_GEOMETRY_ID for a miss.
   uint32_t primitiveOf(size_t i) const {
     return RTCHitN_primID(hitsOf(i), storage_.width(), storage_.laneOf(i));
   }

@@ -3,6 +3,7 @@
 #include "accel/sampling_lanes.h"
 #include "packet/bsdf_batch.h"
 #include "packet/caustic_wave.h"
+#include "packet/hit_prefetch.h"
 #include "renderer/sampler_lanes.h"
 
 #include <algorithm>
@@ -82,23 +83,6 @@ void sampleLights(Wave& wave, size_t queries, size_t lights) {
   }
 }
 
-// Before the bounce's hit at position o of the grouped order is settled: starts loading the
-// triangle indices of the hit kPrefetchDistance positions later and the vertices of the one half as
-// far (Scene::prefetchTriangle, prefetchVertices), so that on a large mesh their cache misses
-// overlap the work on the hits between (perf: the two loads were 65% of Scene::surfaceHit on the
-// million-triangle scaling scene).
-void prefetchHits(const Scene& scene, const Wave& wave, size_t o, size_t active) {
-  constexpr size_t kPrefetchDistance = 16;
-  const auto prefetch = [&](size_t ahead, auto step) {
-    if (o + ahead >= active) return;
-    const size_t a = wave.groups.order()[o + ahead];
-    const uint32_t geomID = wave.closest.geometryOf(a);
-    if (geomID != RTC_INVALID_GEOMETRY_ID) step(geomID, wave.closest.primitiveOf(a));
-  };
-  prefetch(kPrefetchDistance, [&](uint32_t g, uint32_t p) { scene.prefetchTriangle(g, p); });
-  prefetch(kPrefetchDistance / 2, [&](uint32_t g, uint32_t p) { scene.prefetchVertices(g, p); });
-}
-
 }  // namespace
 
 void WavefrontIntegrator::traceCaustics(const Scene& scene, uint64_t seed, SamplerType sampler,
@@ -151,9 +135,9 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
       // choice, then the lights' samples, then shadow rays and scattering.
       wave.groups.group(wave.closest, active, scene.geometryCount());
       size_t vertices = 0, lightDraws = 0, queries = 0;
-      const bool prefetch = scene.hasMeshes();
+      const bool prefetch = scene.prefetchesMeshHits();
       for (size_t o = 0; o < active; ++o) {
-        if (prefetch) prefetchHits(scene, wave, o, active);
+        if (prefetch) prefetchGroupedHits(scene, wave.closest, wave.groups, o, active);
         const size_t a = wave.groups.order()[o];
         Wave::Lane& lane = wave.lanes[wave.active[a]];
         RawHit raw;

@@ -46,6 +46,7 @@ void Scene::build() {
   environment_ = nullptr;
   accel_ = std::make_unique<EmbreeAccel>();
   records_.clear();
+  meshBytes_ = 0;
   triangleLights_.clear();
   std::vector<Light*> allLights;
   for (auto& light : lights) allLights.push_back(light.get());
@@ -86,7 +87,10 @@ void Scene::build() {
       }
     }
     records_[id] = rec;
-    hasMeshes_ = true;
+    const TriangleMesh& m = *entry.mesh;
+    meshBytes_ += m.indices.size() * sizeof(m.indices[0]) + m.positions.size() * sizeof(m.positions[0]) +
+                  m.normals.size() * sizeof(m.normals[0]) + m.uvs.size() * sizeof(m.uvs[0]) +
+                  m.tangents.size() * sizeof(m.tangents[0]);
   }
   accel_->commit();
   bounds_ = accel_->bounds();

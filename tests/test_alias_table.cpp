@@ -53,8 +53,12 @@ TEST(AliasTable, NonDyadicWeightsGetTheirShareToTheGridStep) {
 
 TEST(AliasTable, UOutsideTheUnitIntervalStillGivesAnOutcome) {
   const AliasTable table({1.0, 2.0, 3.0});
-  for (float u : {-1.0f, 1.0f, 2.0f, std::nanf(""), -std::numeric_limits<float>::infinity()})
+  for (float u : {-1.0f, 1.0f, 2.0f, std::nanf(""), -std::numeric_limits<float>::infinity(),
+                  std::numeric_limits<float>::infinity(), std::numeric_limits<float>::max()})
     EXPECT_LT(table.sample(u), 3u) << u;
+  // At 1 and above, all alike: the last bin, past its threshold.
+  for (float u : {2.0f, std::numeric_limits<float>::max(), std::numeric_limits<float>::infinity()})
+    EXPECT_EQ(table.sample(u), table.sample(1.0f)) << u;
 }
 
 TEST(AliasTable, RejectsNegativeNonFiniteOrAllZeroWeights) {
