@@ -192,6 +192,28 @@ TEST(Wavefront, SameImageAsScalarOnGltfMeshes) {
   }
 }
 
+// Meshes larger than the caches get their hits' triangles and vertices prefetched
+// (packet/hit_prefetch.h, above Scene::kPrefetchMeshBytes): a hint that must not change the image,
+// and whose reads of the index buffer the sanitizer build checks. The grid's meshes are padded
+// with unused copies of a vertex until they pass the threshold; no triangle uses them.
+TEST(Wavefront, SameImageAsScalarWhereMeshHitsArePrefetched) {
+  Scene scene = loadScene(test::sourcePath("scenes/gltf/sphere-grid.gltf"));
+  scene.settings.width = 29;
+  scene.settings.height = 23;
+  scene.build();
+  ASSERT_FALSE(scene.prefetchesMeshHits());
+  ASSERT_FALSE(scene.meshes.empty());
+  TriangleMesh& mesh = *scene.meshes.front().mesh;
+  const size_t padding = Scene::kPrefetchMeshBytes / sizeof(Vec3) + 1;
+  mesh.positions.resize(mesh.positions.size() + padding, mesh.positions.front());
+  if (!mesh.normals.empty()) mesh.normals.resize(mesh.positions.size(), mesh.normals.front());
+  if (!mesh.uvs.empty()) mesh.uvs.resize(mesh.positions.size(), mesh.uvs.front());
+  if (!mesh.tangents.empty()) mesh.tangents.resize(mesh.positions.size(), mesh.tangents.front());
+  scene.build();
+  ASSERT_TRUE(scene.prefetchesMeshHits());
+  expectKernelsAgree(scene, "sphere grid, prefetched");
+}
+
 // Thread counts, tile sizes that do not divide the image, tiles larger and smaller than a wave
 // (tile 40: 40 x 30 = 1,200 pixels, more than a wave's 1,024 paths, so one sample index spans two
 // waves), and a sample range that does not start at 0: always the same film.
