@@ -88,7 +88,7 @@ class Scene {
   // some hits later, the second (it reads the indices). Both do nothing for analytic shapes.
   // Worth issuing only when the meshes' indices and vertex attributes are larger than a core's
   // share of the last-level cache (kPrefetchMeshBytes): on the million-triangle scaling scene
-  // (28 MB) they gained 3-4% of the render time; on scenes/gltf-mixed.json (250 K triangles)
+  // (28 MB) they saved 3-7% of the render time; on scenes/gltf-mixed.json (250 K triangles)
   // they cost 1% more instructions and gained nothing measurable.
   static constexpr size_t kPrefetchMeshBytes = size_t(16) << 20;
   bool prefetchesMeshHits() const { return meshBytes_ > kPrefetchMeshBytes; }
