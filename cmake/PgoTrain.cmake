@@ -1,8 +1,8 @@
 # The training run of a profile-guided build (cmake/Pgo.cmake): the instrumented EMBER renders
 # the shipped scenes other than the four benchmark scenes, which together use every analytic
-# shape, material and emitter type, textures and normal maps, glTF meshes, a spot light, an
-# environment map and the caustic light tracer (demo.json, by default), then the demo again with
-# the path tracer alone. One thread: the counters then see the same work whatever the machine.
+# shape, material and emitter type, textures and normal maps, glTF meshes, point, spot and
+# directional lights (courtyard.json, gltf-mixed.json), an environment map and the caustic light
+# tracer (demo.json, by default), then the demo again with the path tracer alone. One thread: the counters then see the same work whatever the machine.
 # Run as: cmake -DEMBER=<instrumented ember> -DSOURCE=<source dir> -DOUT=<scratch dir> -P PgoTrain.cmake
 foreach(var EMBER SOURCE OUT)
   if(NOT ${var})
@@ -14,6 +14,7 @@ file(MAKE_DIRECTORY ${OUT})
 set(runs "scenes/demo.json"
          "scenes/demo.json --caustics path --width 128 --height 128"
          "scenes/gltf-mixed.json"
+         "scenes/courtyard.json"
          "scenes/gltf/bricks.gltf"
          "scenes/gltf/sphere-grid.gltf")
 foreach(run IN LISTS runs)

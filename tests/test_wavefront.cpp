@@ -88,7 +88,8 @@ void expectKernelsAgree(Scene& scene, const std::string& name, const RenderCase&
 }
 
 TEST(Wavefront, SameImageAsScalarOnTheShippedScenes) {
-  for (const char* name : {"cornell-area", "cornell-point", "shapes", "textured", "demo", "gltf-mixed"}) {
+  for (const char* name :
+       {"cornell-area", "cornell-point", "shapes", "textured", "demo", "gltf-mixed", "courtyard"}) {
     Scene scene = loadSmall(test::sourcePath(std::string("scenes/") + name + ".json"), 40, 36);
     expectKernelsAgree(scene, name);
   }
