@@ -22,12 +22,12 @@ void WidenedTfar(const float* tfar, const int* valid, float* widened, unsigned n
   unsigned i = 0;
   for (; i + step <= n; i += step) {
     const auto t = hn::LoadU(d, tfar + i);
-    const auto live = hn::RebindMask(d, hn::Ne(hn::LoadU(di, valid + i), hn::Zero(di)));
+    const auto live = hn::RebindMask(d, hn::Eq(hn::LoadU(di, valid + i), hn::Set(di, -1)));
     // The next float up of a positive float is its bit pattern plus one.
     const auto up = hn::BitCast(d, hn::Add(hn::BitCast(di, t), hn::Set(di, 1)));
     hn::StoreU(hn::IfThenElse(hn::And(live, hn::Lt(t, infinity)), up, t), d, widened + i);
   }
-  for (; i < n; ++i) widened[i] = valid[i] ? nextFloatUp(tfar[i]) : tfar[i];
+  for (; i < n; ++i) widened[i] = valid[i] == -1 ? nextFloatUp(tfar[i]) : tfar[i];
 }
 
 }  // namespace ember::HWY_NAMESPACE

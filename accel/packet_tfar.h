@@ -25,7 +25,8 @@ inline float nextFloatUp(float x) {
 }
 
 // For lanes [0, n), n <= kPacketTfarLanes: widened[i] is the next float above tfar[i] for each
-// live lane (valid[i] != 0; +infinity stays), and tfar[i] for the others.
+// live lane (valid[i] == -1, as for the shapes' lane kernels; +infinity stays), and tfar[i] for
+// the others.
 void widenedTfar(const float* tfar, const int* valid, float* widened, unsigned n);
 
 }  // namespace ember

@@ -50,19 +50,19 @@ void validMask(int (&valid)[kMaxWidth], size_t count) {
 
 // Stream calls have no valid mask, and where Embree splits a packet wider than its own it looks
 // past the mask too: so the unused lanes of the last packet always get the valid, empty interval
-// (1, 0) at the origin, which Embree treats as an inactive ray. (Left as they were, they held
+// (1, 0) at the origin: the InactiveRay (packet/traceable_lanes.h). (Left as they were, they held
 // whatever the storage held: an uninitialised lane tripped Embree's assertion that every active
 // ray is valid.)
 void disableLanes(RTCRayN* p, unsigned n, size_t from) {
   for (size_t i = from; i < n; ++i) {
-    RTCRayN_org_x(p, n, unsigned(i)) = 0.0f;
-    RTCRayN_org_y(p, n, unsigned(i)) = 0.0f;
-    RTCRayN_org_z(p, n, unsigned(i)) = 0.0f;
-    RTCRayN_dir_x(p, n, unsigned(i)) = 0.0f;
-    RTCRayN_dir_y(p, n, unsigned(i)) = 0.0f;
-    RTCRayN_dir_z(p, n, unsigned(i)) = 1.0f;
-    RTCRayN_tnear(p, n, unsigned(i)) = 1.0f;
-    RTCRayN_tfar(p, n, unsigned(i)) = 0.0f;
+    RTCRayN_org_x(p, n, unsigned(i)) = InactiveRay::kOrigin;
+    RTCRayN_org_y(p, n, unsigned(i)) = InactiveRay::kOrigin;
+    RTCRayN_org_z(p, n, unsigned(i)) = InactiveRay::kOrigin;
+    RTCRayN_dir_x(p, n, unsigned(i)) = InactiveRay::kDirX;
+    RTCRayN_dir_y(p, n, unsigned(i)) = InactiveRay::kDirY;
+    RTCRayN_dir_z(p, n, unsigned(i)) = InactiveRay::kDirZ;
+    RTCRayN_tnear(p, n, unsigned(i)) = InactiveRay::kTnear;
+    RTCRayN_tfar(p, n, unsigned(i)) = InactiveRay::kTfar;
   }
 }
 

@@ -20,7 +20,10 @@ template <class D>
 HWY_INLINE void disableInPackets(D d, float* first, size_t packets, size_t stride, unsigned width) {
   // As accel/embree_accel.h's traceable() compares each coordinate with it.
   const auto large = hn::Set(d, kEmbreeLarge);
-  const auto zero = hn::Zero(d), one = hn::Set(d, 1.0f);
+  const auto origin0 = hn::Set(d, InactiveRay::kOrigin), tnear0 = hn::Set(d, InactiveRay::kTnear),
+             tfar0 = hn::Set(d, InactiveRay::kTfar);
+  const auto dirX0 = hn::Set(d, InactiveRay::kDirX), dirY0 = hn::Set(d, InactiveRay::kDirY),
+             dirZ0 = hn::Set(d, InactiveRay::kDirZ);
   const unsigned step = unsigned(hn::Lanes(d));
   for (size_t k = 0; k < packets; ++k) {
     float* p = first + k * stride;
@@ -36,8 +39,8 @@ HWY_INLINE void disableInPackets(D d, float* first, size_t packets, size_t strid
       auto keep = [&](Field f, const hn::Vec<D>& inactive) {
         hn::StoreU(hn::IfThenElse(ok, hn::LoadU(d, field(f)), inactive), d, field(f));
       };
-      keep(kOrgX, zero), keep(kOrgY, zero), keep(kOrgZ, zero), keep(kTnear, one);
-      keep(kDirX, zero), keep(kDirY, zero), keep(kDirZ, one), keep(kTfar, zero);
+      keep(kOrgX, origin0), keep(kOrgY, origin0), keep(kOrgZ, origin0), keep(kTnear, tnear0);
+      keep(kDirX, dirX0), keep(kDirY, dirY0), keep(kDirZ, dirZ0), keep(kTfar, tfar0);
     }
   }
 }

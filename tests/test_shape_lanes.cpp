@@ -750,7 +750,7 @@ TEST(PacketTfar, VectorPassEqualsTheScalarLoopOnEveryTarget) {
         std::fill(widened, widened + kPacketTfarLanes, -9.0f);
         std::fill(widenedExpected, widenedExpected + kPacketTfarLanes, -9.0f);
         std::memcpy(expected, tfar, sizeof(tfar));
-        for (unsigned i = 0; i < n; ++i) widenedExpected[i] = valid[i] ? nextFloatUp(tfar[i]) : tfar[i];
+        for (unsigned i = 0; i < n; ++i) widenedExpected[i] = valid[i] == -1 ? nextFloatUp(tfar[i]) : tfar[i];
         widenedTfar(tfar, valid, widened, n);
         ASSERT_EQ(0, std::memcmp(widened, widenedExpected, sizeof(widened)))
             << "n " << n << " trial " << trial;
