@@ -4,7 +4,8 @@
 // area light — as single rays (rtcIntersect1/rtcOccluded1) and as 8- and 16-wide packets, on 1 and
 // on all threads. The scene is Ember's own (analytic user geometry), so the numbers include the
 // cost of our intersection callbacks, exactly as Ember pays it.
-//   embree_raw_throughput [scene.json] [--rays N]
+//   embree_raw_throughput [scene.json] [--rays N] [--mix-only]
+// --mix-only measures the two vertex-mix rows alone (the limit), for benchmarks/limit_fraction.py.
 #include "core/sampling.h"
 #include "io/scene_loader.h"
 #include "packet/ray_batch.h"
@@ -84,9 +85,12 @@ double measure(size_t n, int threads, Work work) {
 int run(int argc, char** argv) {
   std::string path = std::string(EMBER_SOURCE_DIR) + "/scenes/cornell-area.json";
   size_t n = 2'000'000;
+  bool mixOnly = false;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--rays") && i + 1 < argc)
       n = std::stoul(argv[++i]);
+    else if (!std::strcmp(argv[i], "--mix-only"))
+      mixOnly = true;
     else
       path = argv[i];
   }
@@ -101,6 +105,7 @@ int run(int argc, char** argv) {
   std::printf("%-34s %10s %10s\n", "ray kind (Mrays/s)", "1 thread",
               std::to_string(all).append(" threads").c_str());
   auto row = [&](const char* name, auto work) {
+    if (mixOnly && std::strncmp(name, "vertex mix", 10) != 0) return;
     const double one = measure(n, 1, work);
     const double many = measure(n, all, work);
     std::printf("%-34s %10.2f %10.2f\n", name, one, many);

@@ -1,0 +1,98 @@
+#!/usr/bin/env python3
+"""Path vertices/s as a fraction of the traversal limit (issue 10), in paired rounds.
+
+The limit is Embree's best rate for the path tracer's ray mix in the cornell-area geometry, with
+our callbacks (benchmarks/embree_raw_throughput.cpp, its two "vertex mix" rows: the faster one).
+On a shared VM the limit itself moves by a third between runs minutes apart, so a fraction is
+only meaningful when the limit and Ember's rate are measured back to back. Each round runs
+
+    embree_raw_throughput --rays R --mix-only          (the limit on 1 and on all threads)
+    ember bench SCENE --spp S --repeat K --caustics path --threads 1
+    ember bench SCENE --spp S --repeat K --caustics path --threads N
+
+and takes the fraction from those three runs alone; the rounds' spread is the measurement's
+noise. Also reported per round: the thread scaling (samples/s at N threads over 1 thread).
+
+    benchmarks/limit_fraction.py --ember build-pgo/app/ember \\
+        --raw build-pgo/benchmarks/embree_raw_throughput --rounds 8 --json out.json
+"""
+import argparse
+import json
+import os
+import re
+import statistics
+import subprocess
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+
+
+def limit(raw, rays):
+    """(1-thread limit, all-threads limit) in M path vertices/s: the faster vertex-mix row."""
+    out = subprocess.run([raw, "--rays", str(rays), "--mix-only"], check=True, capture_output=True,
+                         text=True).stdout
+    rows = [line for line in out.splitlines() if line.startswith("vertex mix")]
+    if len(rows) != 2:
+        sys.exit(f"limit_fraction: expected two vertex-mix rows from {raw}, got:\n{out}")
+    values = [[float(x) for x in re.findall(r"\d+\.\d+", row)[-2:]] for row in rows]
+    return max(v[0] for v in values), max(v[1] for v in values)
+
+
+def bench(ember, scene, spp, repeat, threads):
+    """(M path vertices/s, samples/s) of one `ember bench` run (the median of its repeats)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "bench.json")
+        subprocess.run([ember, "bench", scene, "--spp", str(spp), "--repeat", str(repeat), "--caustics", "path",
+                        "--threads", str(threads), "--json", path], check=True, capture_output=True)
+        with open(path) as f:
+            s = json.load(f)["scenes"][0]
+    return s["path_vertices_per_second"] * 1e-6, s["samples_per_second"]
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--ember", default=os.path.join(ROOT, "build-pgo", "app", "ember"))
+    ap.add_argument("--raw", default=os.path.join(ROOT, "build-pgo", "benchmarks", "embree_raw_throughput"))
+    ap.add_argument("--scene", default=os.path.join(ROOT, "scenes", "cornell-area.json"))
+    ap.add_argument("--rounds", type=int, default=8)
+    ap.add_argument("--rays", type=int, default=4_000_000, help="rays per limit measurement")
+    ap.add_argument("--spp", type=int, default=64, help="samples per pixel per Ember run")
+    ap.add_argument("--repeat", type=int, default=3, help="renders per Ember run (their median counts)")
+    ap.add_argument("--threads", type=int, default=os.cpu_count(), help="the many-thread count")
+    ap.add_argument("--json", help="also write every round here")
+    args = ap.parse_args()
+
+    rounds = []
+    print(f"{'round':>5} {'limit 1t':>9} {'ember 1t':>9} {'fraction':>9} "
+          f"{'limit {}t'.format(args.threads):>9} {'ember {}t'.format(args.threads):>9} {'fraction':>9} {'scaling':>8}")
+    for k in range(args.rounds):
+        lim1, limN = limit(args.raw, args.rays)
+        v1, s1 = bench(args.ember, args.scene, args.spp, args.repeat, 1)
+        vN, sN = bench(args.ember, args.scene, args.spp, args.repeat, args.threads)
+        r = {"limit_1": lim1, "ember_1": v1, "fraction_1": v1 / lim1, "limit_n": limN, "ember_n": vN,
+             "fraction_n": vN / limN, "scaling": sN / s1}
+        rounds.append(r)
+        print(f"{k + 1:>5} {lim1:9.2f} {v1:9.2f} {r['fraction_1']:9.1%} {limN:9.2f} {vN:9.2f} "
+              f"{r['fraction_n']:9.1%} {r['scaling']:8.2f}", flush=True)
+
+    def summary(key):
+        values = sorted(r[key] for r in rounds)
+        return {"median": statistics.median(values), "min": values[0], "max": values[-1]}
+
+    result = {"threads": args.threads, "spp": args.spp, "repeat": args.repeat, "rays": args.rays, "scene": args.scene,
+              "rounds": rounds, "fraction_1": summary("fraction_1"), "fraction_n": summary("fraction_n"),
+              "scaling": summary("scaling")}
+    for key, name in (("fraction_1", "fraction, 1 thread"), ("fraction_n", f"fraction, {args.threads} threads"),
+                      ("scaling", "thread scaling")):
+        s = result[key]
+        fmt = "{:.1%}" if key != "scaling" else "{:.2f}"
+        print(f"{name}: median {fmt.format(s['median'])} (range {fmt.format(s['min'])}-{fmt.format(s['max'])})")
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(result, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()
