@@ -122,6 +122,8 @@ int runBench(const BenchArgs& a) {
       runs.push_back(render(scene, *integrator, options, film));
       anonymousMb = std::max(anonymousMb, anonymousResidentMb());  // scene, BVH and film alive
     }
+    nlohmann::json secondsInRunOrder = nlohmann::json::array();
+    for (const RenderStats& r : runs) secondsInRunOrder.push_back(r.seconds);
     std::sort(runs.begin(), runs.end(),
               [](const RenderStats& x, const RenderStats& y) { return x.seconds < y.seconds; });
     const RenderStats& med = runs[runs.size() / 2];
@@ -136,7 +138,7 @@ int runBench(const BenchArgs& a) {
         {"load_seconds", loadSeconds},
         {"build_seconds", buildSeconds},
         {"render_seconds_median", med.seconds},
-        {"render_seconds_all", nlohmann::json::array()},
+        {"render_seconds_all", secondsInRunOrder},
         {"samples_per_second", double(med.samples) / s},
         {"path_vertices_per_second", double(med.paths.vertices) / s},
         {"closest_hit_rays_per_second", double(med.paths.rays) / s},
@@ -146,7 +148,6 @@ int runBench(const BenchArgs& a) {
         {"peak_resident_mb", peakResidentMb()},
         {"anonymous_resident_mb", anonymousMb},
     };
-    for (const RenderStats& r : runs) row["render_seconds_all"].push_back(r.seconds);
     report["scenes"].push_back(row);
     std::printf(
         "%-22s %7d %5d %8.3f %8.3f %9.3f %10.3f %10.3f %10.3f %10.3f %9llu %8.1f %8.1f\n",
