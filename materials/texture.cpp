@@ -4,6 +4,7 @@
 #include <bit>
 #include <cstdint>
 #include <cstring>
+#include <vector>
 
 namespace ember {
 
@@ -68,23 +69,41 @@ class ColorPalette {
 
 }  // namespace
 
-float decodeSrgb(float c) {
-  struct Table {
-    std::array<float, 256> encoded, linear;
-    Table() {
-      for (int b = 0; b < 256; ++b) {
-        encoded[size_t(b)] = float(b) / 255.0f;
-        linear[size_t(b)] = srgbToLinear(encoded[size_t(b)]);
-      }
+namespace {
+
+// srgbToLinear of the values an n-bit channel decodes to, b / (2^n - 1), as the image reader
+// computes them (io/image_io.cpp).
+template <size_t kValues>
+struct SrgbTable {
+  static constexpr float kMax = float(kValues - 1);
+  std::vector<float> encoded, linear;
+  SrgbTable() : encoded(kValues), linear(kValues) {
+    for (size_t b = 0; b < kValues; ++b) {
+      encoded[b] = float(b) / kMax;
+      linear[b] = srgbToLinear(encoded[b]);
     }
-  };
-  static const Table table;
-  const float scaled = c * 255.0f + 0.5f;
-  if (scaled >= 0.0f && scaled < 256.0f) {  // false for NaN
-    const size_t b = size_t(scaled);
-    // Compared as bits: -0 must take the formula, which keeps its sign.
-    if (std::bit_cast<uint32_t>(table.encoded[b]) == std::bit_cast<uint32_t>(c)) return table.linear[b];
   }
+  // The decoded value if c is one of the table's values (compared as bits: -0 must take the
+  // formula, which keeps its sign).
+  bool find(float c, float& out) const {
+    const float scaled = c * kMax + 0.5f;
+    if (!(scaled >= 0.0f && scaled < float(kValues))) return false;  // also false for NaN
+    const size_t b = size_t(scaled);
+    if (std::bit_cast<uint32_t>(encoded[b]) != std::bit_cast<uint32_t>(c)) return false;
+    out = linear[b];
+    return true;
+  }
+};
+
+}  // namespace
+
+float decodeSrgb(float c) {
+  static const SrgbTable<256> table8;
+  float out;
+  if (table8.find(c, out)) return out;
+  // The 16-bit table (512 KB) is built by the first value the 8-bit one does not hold.
+  static const SrgbTable<65536> table16;
+  if (table16.find(c, out)) return out;
   return srgbToLinear(c);
 }
 

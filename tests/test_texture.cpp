@@ -37,8 +37,8 @@ void expectExactTexels(const std::vector<Color>& texels, int width, int height, 
   }
 }
 
-// The table-backed decoder equals the sRGB formula bit for bit: on the 256 values an 8-bit
-// channel decodes to, their float neighbours, and values no table holds.
+// The table-backed decoder equals the sRGB formula bit for bit: on the values an 8-bit and a
+// 16-bit channel decode to, their float neighbours, and values no table holds.
 TEST(Srgb, TableDecodeEqualsTheFormula) {
   auto same = [](float c) {
     const float got = decodeSrgb(c), want = srgbToLinear(c);
@@ -50,6 +50,12 @@ TEST(Srgb, TableDecodeEqualsTheFormula) {
     EXPECT_TRUE(same(c)) << b;
     EXPECT_TRUE(same(std::nextafter(c, 2.0f))) << b;
     EXPECT_TRUE(same(std::nextafter(c, -1.0f))) << b;
+  }
+  for (int b = 0; b < 65536; ++b) {
+    const float c = float(b) / 65535.0f;
+    ASSERT_TRUE(same(c)) << b;
+    ASSERT_TRUE(same(std::nextafter(c, 2.0f))) << b;
+    ASSERT_TRUE(same(std::nextafter(c, -1.0f))) << b;
   }
   Rng rng(3, 1);
   for (int i = 0; i < 100000; ++i) ASSERT_TRUE(same(1.2f * rng.uniform() - 0.1f)) << i;
