@@ -10,7 +10,8 @@ only meaningful when the limit and Ember's rate are measured back to back. Each 
     ember bench SCENE --spp S --repeat K --caustics path --threads 1
     ember bench SCENE --spp S --repeat K --caustics path --threads N
 
-and takes the fraction from those three runs alone; the rounds' spread is the measurement's
+and takes the fraction from those three runs alone (the limit's two thread counts are measured
+first, so the many-thread pair is some fifteen seconds apart); the rounds' spread is the measurement's
 noise. Also reported: per round, the thread scaling (samples/s at N threads over 1 thread); over
 all rounds, the best Ember rate over the best limit (best-of-N, the steadier figure when the
 host's speed moves within a round).
@@ -31,10 +32,22 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 
 
-def limit(raw, rays):
+def run(command):
+    """stdout of a command; its stderr and exit status if it fails."""
+    done = subprocess.run(command, capture_output=True, text=True)
+    if done.returncode != 0:
+        sys.exit(f"limit_fraction: {' '.join(command)} failed ({done.returncode}):\n{done.stderr}")
+    return done.stdout
+
+
+def limit(raw, rays, threads):
     """(1-thread limit, all-threads limit) in M path vertices/s: the faster vertex-mix row."""
-    out = subprocess.run([raw, "--rays", str(rays), "--mix-only"], check=True, capture_output=True,
-                         text=True).stdout
+    out = run([raw, "--rays", str(rays), "--mix-only"])
+    # The benchmark's "all threads" are oneTBB's default concurrency; Ember must run as many.
+    header = re.search(r"1 thread\s+(\d+) threads", out)
+    if not header or int(header.group(1)) != threads:
+        sys.exit(f"limit_fraction: {raw} measured {header.group(1) if header else '?'} threads, "
+                 f"Ember is asked for {threads} (--threads)")
     rows = [line for line in out.splitlines() if line.startswith("vertex mix")]
     if len(rows) != 2:
         sys.exit(f"limit_fraction: expected two vertex-mix rows from {raw}, got:\n{out}")
@@ -47,8 +60,8 @@ def bench(ember, scene, spp, repeat, threads, keep=None):
     JSON is kept at `keep` if given."""
     with tempfile.TemporaryDirectory() as tmp:
         path = keep or os.path.join(tmp, "bench.json")
-        subprocess.run([ember, "bench", scene, "--spp", str(spp), "--repeat", str(repeat), "--caustics", "path",
-                        "--threads", str(threads), "--json", path], check=True, capture_output=True)
+        run([ember, "bench", scene, "--spp", str(spp), "--repeat", str(repeat), "--caustics", "path",
+             "--threads", str(threads), "--json", path])
         with open(path) as f:
             s = json.load(f)["scenes"][0]
     return s["path_vertices_per_second"] * 1e-6, s["samples_per_second"]
@@ -63,18 +76,22 @@ def main():
     ap.add_argument("--rays", type=int, default=4_000_000, help="rays per limit measurement")
     ap.add_argument("--spp", type=int, default=64, help="samples per pixel per Ember run")
     ap.add_argument("--repeat", type=int, default=3, help="renders per Ember run (their median counts)")
-    ap.add_argument("--threads", type=int, default=os.cpu_count(), help="the many-thread count")
+    ap.add_argument("--threads", type=int, default=len(os.sched_getaffinity(0)),
+                    help="the many-thread count: the CPUs this process may run on, as oneTBB counts them")
     ap.add_argument("--json", help="also write every round here")
     ap.add_argument("--keep-bench", metavar="PREFIX",
                     help="keep each round's `ember bench` JSON as PREFIX-t1-K.json and PREFIX-tN-K.json "
                          "(for benchmarks/plot.py)")
     args = ap.parse_args()
+    if args.rounds < 1:
+        ap.error("--rounds must be at least 1")
 
     rounds = []
+    many = f"{args.threads}t"
     print(f"{'round':>5} {'limit 1t':>9} {'ember 1t':>9} {'fraction':>9} "
-          f"{'limit {}t'.format(args.threads):>9} {'ember {}t'.format(args.threads):>9} {'fraction':>9} {'scaling':>8}")
+          f"{'limit ' + many:>9} {'ember ' + many:>9} {'fraction':>9} {'scaling':>8}")
     for k in range(args.rounds):
-        lim1, limN = limit(args.raw, args.rays)
+        lim1, limN = limit(args.raw, args.rays, args.threads)
         keep = (lambda t: f"{args.keep_bench}-t{t}-{k + 1}.json") if args.keep_bench else (lambda t: None)
         v1, s1 = bench(args.ember, args.scene, args.spp, args.repeat, 1, keep(1))
         vN, sN = bench(args.ember, args.scene, args.spp, args.repeat, args.threads, keep(args.threads))
@@ -90,15 +107,18 @@ def main():
 
     # On a host whose speed moves within a round, the best rate each side reached is the steadier
     # estimate of what the code can do (the usual best-of-N of noisy timing).
-    best = {n: max(r["ember_" + n] for r in rounds) / max(r["limit_" + n] for r in rounds) for n in ("1", "n")}
-    result = {"best_fraction_1": best["1"], "best_fraction_n": best["n"], "threads": args.threads, "spp": args.spp, "repeat": args.repeat, "rays": args.rays, "scene": args.scene,
-              "rounds": rounds, "fraction_1": summary("fraction_1"), "fraction_n": summary("fraction_n"),
+    best = {n: max(r["ember_" + n] for r in rounds) / max(r["limit_" + n] for r in rounds)
+            for n in ("1", "n")}
+    result = {"best_fraction_1": best["1"], "best_fraction_n": best["n"], "threads": args.threads,
+              "spp": args.spp, "repeat": args.repeat, "rays": args.rays, "scene": args.scene, "rounds": rounds,
+              "fraction_1": summary("fraction_1"), "fraction_n": summary("fraction_n"),
               "scaling": summary("scaling")}
     for key, name in (("fraction_1", "fraction, 1 thread"), ("fraction_n", f"fraction, {args.threads} threads"),
                       ("scaling", "thread scaling")):
         s = result[key]
         fmt = "{:.1%}" if key != "scaling" else "{:.2f}"
-        print(f"{name}: median {fmt.format(s['median'])} (range {fmt.format(s['min'])}-{fmt.format(s['max'])})")
+        print(f"{name}: median {fmt.format(s['median'])} "
+              f"(range {fmt.format(s['min'])}-{fmt.format(s['max'])})")
     print(f"best Ember rate over best limit: {best['1']:.1%} on 1 thread, {best['n']:.1%} on {args.threads}")
     if args.json:
         with open(args.json, "w") as f:

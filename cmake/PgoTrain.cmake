@@ -2,7 +2,8 @@
 # the shipped scenes other than the four benchmark scenes, which together use every analytic
 # shape, material and emitter type, textures and normal maps, glTF meshes, point, spot and
 # directional lights (courtyard.json, gltf-mixed.json), an environment map and the caustic light
-# tracer (demo.json, by default), then the demo again with the path tracer alone. One thread: the counters then see the same work whatever the machine.
+# tracer (demo.json, by default), then the demo again with the path tracer alone.
+# One thread: the counters then see the same work whatever the machine.
 # Run as: cmake -DEMBER=<instrumented ember> -DSOURCE=<source dir> -DOUT=<scratch dir> -P PgoTrain.cmake
 foreach(var EMBER SOURCE OUT)
   if(NOT ${var})

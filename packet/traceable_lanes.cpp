@@ -20,10 +20,10 @@ template <class D>
 HWY_INLINE void disableInPackets(D d, float* first, size_t packets, size_t stride, unsigned width) {
   // As accel/embree_accel.h's traceable() compares each coordinate with it.
   const auto large = hn::Set(d, kEmbreeLarge);
-  const auto origin0 = hn::Set(d, InactiveRay::kOrigin), tnear0 = hn::Set(d, InactiveRay::kTnear),
-             tfar0 = hn::Set(d, InactiveRay::kTfar);
-  const auto dirX0 = hn::Set(d, InactiveRay::kDirX), dirY0 = hn::Set(d, InactiveRay::kDirY),
-             dirZ0 = hn::Set(d, InactiveRay::kDirZ);
+  const auto inactiveOrigin = hn::Set(d, InactiveRay::kOrigin),
+             inactiveTnear = hn::Set(d, InactiveRay::kTnear), inactiveTfar = hn::Set(d, InactiveRay::kTfar);
+  const auto inactiveDirX = hn::Set(d, InactiveRay::kDirX), inactiveDirY = hn::Set(d, InactiveRay::kDirY),
+             inactiveDirZ = hn::Set(d, InactiveRay::kDirZ);
   const unsigned step = unsigned(hn::Lanes(d));
   for (size_t k = 0; k < packets; ++k) {
     float* p = first + k * stride;
@@ -39,8 +39,10 @@ HWY_INLINE void disableInPackets(D d, float* first, size_t packets, size_t strid
       auto keep = [&](Field f, const hn::Vec<D>& inactive) {
         hn::StoreU(hn::IfThenElse(ok, hn::LoadU(d, field(f)), inactive), d, field(f));
       };
-      keep(kOrgX, origin0), keep(kOrgY, origin0), keep(kOrgZ, origin0), keep(kTnear, tnear0);
-      keep(kDirX, dirX0), keep(kDirY, dirY0), keep(kDirZ, dirZ0), keep(kTfar, tfar0);
+      keep(kOrgX, inactiveOrigin), keep(kOrgY, inactiveOrigin), keep(kOrgZ, inactiveOrigin),
+          keep(kTnear, inactiveTnear);
+      keep(kDirX, inactiveDirX), keep(kDirY, inactiveDirY), keep(kDirZ, inactiveDirZ),
+          keep(kTfar, inactiveTfar);
     }
   }
 }

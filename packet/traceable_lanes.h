@@ -20,8 +20,7 @@ struct InactiveRay {
 // For each of `packets` packets of `width` rays in Embree's RTCRayN layout (field f of lane i at
 // packet[f * width + i]), `stride` floats apart from `first` on: every lane whose ray is not
 // traceable becomes the InactiveRay, which misses everything and is blocked by nothing, as
-// EmbreeAccel treats such single rays. The other
-// lanes keep their rays bit for bit.
+// EmbreeAccel treats such single rays. The other lanes keep their rays bit for bit.
 void disableUntraceableRays(float* first, size_t packets, size_t stride, unsigned width);
 
 }  // namespace ember
