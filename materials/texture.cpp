@@ -69,41 +69,21 @@ class ColorPalette {
 
 }  // namespace
 
-namespace {
-
-// srgbToLinear of the values an n-bit channel decodes to, b / (2^n - 1), as the image reader
-// computes them (io/image_io.cpp).
-template <size_t kValues>
-struct SrgbTable {
-  static constexpr float kMax = float(kValues - 1);
-  std::vector<float> encoded, linear;
-  SrgbTable() : encoded(kValues), linear(kValues) {
-    for (size_t b = 0; b < kValues; ++b) {
-      encoded[b] = float(b) / kMax;
-      linear[b] = srgbToLinear(encoded[b]);
-    }
-  }
-  // The decoded value if c is one of the table's values (compared as bits: -0 must take the
-  // formula, which keeps its sign).
-  bool find(float c, float& out) const {
-    const float scaled = c * kMax + 0.5f;
-    if (!(scaled >= 0.0f && scaled < float(kValues))) return false;  // also false for NaN
-    const size_t b = size_t(scaled);
-    if (std::bit_cast<uint32_t>(encoded[b]) != std::bit_cast<uint32_t>(c)) return false;
-    out = linear[b];
-    return true;
-  }
-};
-
-}  // namespace
-
 float decodeSrgb(float c) {
-  static const SrgbTable<256> table8;
-  float out;
-  if (table8.find(c, out)) return out;
-  // The 16-bit table (512 KB) is built by the first value the 8-bit one does not hold.
-  static const SrgbTable<65536> table16;
-  if (table16.find(c, out)) return out;
+  // srgbToLinear of the 65,536 values a 16-bit channel decodes to, b / 65535, as the image reader
+  // computes them (io/image_io.cpp). An 8-bit channel's b / 255 is the same rational number as
+  // 257 b / 65535, and both round to the same float, so the one table serves both depths.
+  static const std::vector<float> linear = [] {
+    std::vector<float> table(65536);
+    for (size_t b = 0; b < table.size(); ++b) table[b] = srgbToLinear(float(b) / 65535.0f);
+    return table;
+  }();
+  const float scaled = c * 65535.0f + 0.5f;
+  if (scaled >= 0.0f && scaled < 65536.0f) {  // false for NaN
+    const size_t b = size_t(scaled);
+    // Compared as bits: -0 must take the formula, which keeps its sign.
+    if (std::bit_cast<uint32_t>(float(b) / 65535.0f) == std::bit_cast<uint32_t>(c)) return linear[b];
+  }
   return srgbToLinear(c);
 }
 

@@ -103,9 +103,9 @@ class UvTransformTexture final : public Texture {
 inline float srgbToLinear(float c) {
   return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
 }
-// srgbToLinear, bit for bit, with tables for the values an 8-bit channel decodes to (b / 255) and
-// a 16-bit one (b / 65535): decoding a texture then costs a lookup or two per channel instead of a
-// pow (most of the time a scene with image textures spent loading them).
+// srgbToLinear, bit for bit, with a table for the values an 8- or 16-bit channel decodes to
+// (b / 255, b / 65535): decoding such a texture then costs a lookup per channel instead of a pow
+// (most of the time a scene with image textures spent loading them).
 float decodeSrgb(float c);
 inline float linearToSrgb(float c) {
   return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
