@@ -320,10 +320,19 @@ SurfacePoint Quad::projectToSurface(const Vec3& p, const LocalHit&) const {
     // components are zeros, and its length one, exactly): only that coordinate moves. The
     // point equals the general projection's up to the sign of a zero coordinate (which the
     // general form can turn from -0 to +0).
-    glm::dvec3 dp(p);
-    const int k = exactRectangle_.axis;
-    dp[k] -= dp[k] - exactRectangle_.c;
-    return roundedPoint(dp);
+    // Coordinate by coordinate: GCC kept a double vector indexed by k on the stack, and its wide
+    // reload after the narrow store of coordinate k stalled on store-to-load forwarding (`perf
+    // annotate`, an AVX-512 Xeon). The other coordinates round-trip through double unchanged.
+    const double c = exactRectangle_.c;
+    const auto onPlane = [c](float x) { return float(double(x) - (double(x) - c)); };
+    switch (exactRectangle_.axis) {
+      case 0:
+        return roundedPoint(onPlane(p.x), p.y, p.z);
+      case 1:
+        return roundedPoint(p.x, onPlane(p.y), p.z);
+      default:
+        return roundedPoint(p.x, p.y, onPlane(p.z));
+    }
   }
   if (samePlanes_) return planes_[0].project(p);
   // The diagonal v0-v2 separates the halves: v1 lies on one side of it, v3 on the other.
