@@ -16,6 +16,7 @@
 #include "renderer/sampler_lanes.h"
 
 #include <gtest/gtest.h>
+#include <hwy/targets.h>
 
 #include <array>
 #include <memory>
@@ -343,7 +344,7 @@ TEST(SamplingLanes, LambertianLanesEqualSingleSamples) {
 // The Sobol kernel is integer arithmetic: equal to the scalar sampler bit for bit, for samplers at
 // every dimension (below, at and past the Sobol ones), both sampler types, any pixel and index,
 // and any run length (partial blocks, blocks interrupted by PCG32 lanes).
-TEST(SamplingLanes, SamplerLanesEqualTheScalarSampler) {
+void expectSamplerLanesEqualTheScalarSampler() {
   Rng rng(29, 7);
   for (const SamplerType type : {SamplerType::Sobol, SamplerType::Independent}) {
     std::vector<Sampler> lanes, reference;
@@ -397,6 +398,19 @@ TEST(SamplingLanes, SamplerLanesEqualTheScalarSampler) {
       }
     }
   }
+}
+
+// On every SIMD target this CPU runs and the build compiled, not only the one dispatch picks: the
+// kernel's bit reversal is written differently for one-lane targets and for byte shuffles.
+TEST(SamplingLanes, SamplerLanesEqualTheScalarSamplerOnEveryTarget) {
+  const std::vector<int64_t> targets = hwy::SupportedAndGeneratedTargets();
+  ASSERT_FALSE(targets.empty());
+  for (const int64_t target : targets) {
+    SCOPED_TRACE(hwy::TargetName(target));
+    hwy::SetSupportedTargetsForTest(target);
+    expectSamplerLanesEqualTheScalarSampler();
+  }
+  hwy::SetSupportedTargetsForTest(0);
 }
 
 }  // namespace
