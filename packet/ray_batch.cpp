@@ -33,11 +33,13 @@ void writeRay(RTCRayN* p, unsigned n, unsigned lane, const Ray& ray) {
   RTCRayN_tfar(p, n, lane) = ray.tMax;
 }
 
-// dst[0] = a, dst[1] = b in one 8-byte store.
-void storePair(float* dst, float a, float b) {
+// A two-float field (a Vec2, or a Vec3's x and y) written as one 8-byte copy, which GCC emits as
+// one 8-byte store (see ClosestHitBatch::hit).
+void storePair(void* field, float a, float b) {
   const float pair[2] = {a, b};
-  std::memcpy(dst, pair, sizeof pair);
+  std::memcpy(field, pair, sizeof pair);
 }
+static_assert(sizeof(Vec2) == 2 * sizeof(float) && sizeof(Vec3) == 3 * sizeof(float));
 
 // The fields no ray changes, written once per packet when the layout is set.
 void initFixedFields(RTCRayN* p, unsigned n) {
@@ -160,8 +162,8 @@ bool ClosestHitBatch::hit(size_t i, RawHit& out) const {
   // ng.xy as 8-byte words): a wide load of narrower, just-made stores waits until they reach the
   // cache instead of taking their values (store-to-load forwarding fails), which `perf annotate`
   // showed as a third of surfaceHit's time on an AVX-512 Xeon.
-  storePair(&out.uv.x, RTCHitN_u(h, n, lane), RTCHitN_v(h, n, lane));
-  storePair(&out.ng.x, RTCHitN_Ng_x(h, n, lane), RTCHitN_Ng_y(h, n, lane));
+  storePair(&out.uv, RTCHitN_u(h, n, lane), RTCHitN_v(h, n, lane));
+  storePair(&out.ng, RTCHitN_Ng_x(h, n, lane), RTCHitN_Ng_y(h, n, lane));
   out.ng.z = RTCHitN_Ng_z(h, n, lane);
   return true;
 }

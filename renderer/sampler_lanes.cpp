@@ -14,14 +14,15 @@ namespace hn = hwy::HWY_NAMESPACE;
 
 // The hashes are 32-bit integer arithmetic (wrapping multiplies), 16 lanes per AVX-512 vector.
 // The dimension seeds' 64-bit mix64 is done while the block is gathered, once per request.
-using D = hn::CappedTag<uint32_t, SobolBlock::kBlock>;  // never wider than a block
+using D = hn::CappedTag<uint32_t, SobolBlock::kBlock>;  // a block is whole vectors
 using V = hn::Vec<D>;
 
 HWY_INLINE V mulBy(D d, V x, uint32_t c) {
   return hn::Mul(x, hn::Set(d, c));
 }
 #if HWY_TARGET == HWY_SCALAR
-// One lane has no bytes to shuffle: shifts and masks.
+// HWY_SCALAR vectors are one lane of their type: there is no bytes view of a 32-bit lane to
+// shuffle, so the reversal stays shifts and masks.
 HWY_INLINE V reverseBits32(D d, V x) {
   x = hn::Or(hn::ShiftRight<16>(x), hn::ShiftLeft<16>(x));
   auto swap = [&](V v, int shift, uint32_t mask) {
@@ -35,28 +36,24 @@ HWY_INLINE V reverseBits32(D d, V x) {
 }
 #else
 // Bit reversal by byte shuffles: each byte's two nibbles reversed through a 16-entry table, then
-// the bytes of each 32-bit lane reversed. Seven operations against thirteen shift-mask-or steps
-// (the hash runs four reversals per 2D request).
+// the bytes of each 32-bit lane reversed by a second shuffle. Fewer operations than the shifts
+// and masks above (the hash reverses four times per 2D request): 0.983 of cornell-area's render
+// time on an AVX-512 host (docs/performance.md, sixteenth session).
 HWY_INLINE V reverseBits32(D d, V x) {
   const hn::Repartition<uint8_t, D> d8;
-  // Every 16-byte block of a vector uses the same table and byte order (TableLookupBytes looks up
-  // within blocks), so both repeat per block.
-  alignas(64) static constexpr uint8_t kNibbleReversed[64] = {
-      0x0, 0x8, 0x4, 0xc, 0x2, 0xa, 0x6, 0xe, 0x1, 0x9, 0x5, 0xd, 0x3, 0xb, 0x7, 0xf,
-      0x0, 0x8, 0x4, 0xc, 0x2, 0xa, 0x6, 0xe, 0x1, 0x9, 0x5, 0xd, 0x3, 0xb, 0x7, 0xf,
-      0x0, 0x8, 0x4, 0xc, 0x2, 0xa, 0x6, 0xe, 0x1, 0x9, 0x5, 0xd, 0x3, 0xb, 0x7, 0xf,
-      0x0, 0x8, 0x4, 0xc, 0x2, 0xa, 0x6, 0xe, 0x1, 0x9, 0x5, 0xd, 0x3, 0xb, 0x7, 0xf};
-  alignas(64) static constexpr uint8_t kBytesReversed[64] = {
-      3,  2,  1,  0,  7, 6, 5,  4,  11, 10, 9, 8, 15, 14, 13, 12, 3,  2,  1,  0,  7, 6,
-      5,  4,  11, 10, 9, 8, 15, 14, 13, 12, 3, 2, 1,  0,  7,  6,  5,  4,  11, 10, 9, 8,
-      15, 14, 13, 12, 3, 2, 1,  0,  7,  6,  5, 4, 11, 10, 9,  8,  15, 14, 13, 12};
-  const auto table = hn::Load(d8, kNibbleReversed);
+  // TableLookupBytes looks up within each 16-byte block, so both tables are one block, repeated
+  // across the vector by LoadDup128 at any width.
+  alignas(16) static constexpr uint8_t kNibbleReversed[16] = {0x0, 0x8, 0x4, 0xc, 0x2, 0xa, 0x6, 0xe,
+                                                              0x1, 0x9, 0x5, 0xd, 0x3, 0xb, 0x7, 0xf};
+  alignas(16) static constexpr uint8_t kBytesReversed[16] = {3,  2,  1, 0, 7,  6,  5,  4,
+                                                             11, 10, 9, 8, 15, 14, 13, 12};
+  const auto table = hn::LoadDup128(d8, kNibbleReversed);
   const auto bytes = hn::BitCast(d8, x);
   const auto low = hn::And(bytes, hn::Set(d8, uint8_t{0x0f}));
   const auto high = hn::ShiftRight<4>(bytes);
   const auto reversed =
       hn::Or(hn::ShiftLeft<4>(hn::TableLookupBytes(table, low)), hn::TableLookupBytes(table, high));
-  return hn::BitCast(d, hn::TableLookupBytes(reversed, hn::Load(d8, kBytesReversed)));
+  return hn::BitCast(d, hn::TableLookupBytes(reversed, hn::LoadDup128(d8, kBytesReversed)));
 }
 #endif
 // Burley 2020, listing 2 (renderer/sampler.h, laineKarras).

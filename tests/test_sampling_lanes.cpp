@@ -14,9 +14,9 @@
 #include "materials/lambertian.h"
 #include "renderer/light.h"
 #include "renderer/sampler_lanes.h"
+#include "simd_targets.h"
 
 #include <gtest/gtest.h>
-#include <hwy/targets.h>
 
 #include <array>
 #include <memory>
@@ -403,14 +403,7 @@ void expectSamplerLanesEqualTheScalarSampler() {
 // On every SIMD target this CPU runs and the build compiled, not only the one dispatch picks: the
 // kernel's bit reversal is written differently for one-lane targets and for byte shuffles.
 TEST(SamplingLanes, SamplerLanesEqualTheScalarSamplerOnEveryTarget) {
-  const std::vector<int64_t> targets = hwy::SupportedAndGeneratedTargets();
-  ASSERT_FALSE(targets.empty());
-  for (const int64_t target : targets) {
-    SCOPED_TRACE(hwy::TargetName(target));
-    hwy::SetSupportedTargetsForTest(target);
-    expectSamplerLanesEqualTheScalarSampler();
-  }
-  hwy::SetSupportedTargetsForTest(0);
+  forEachSimdTarget(expectSamplerLanesEqualTheScalarSampler);
 }
 
 }  // namespace
