@@ -154,8 +154,7 @@ inline SurfacePoint roundedPoint(float x, float y, float z, float size = 0.0f) {
   out.p.x = x;
   out.p.y = y;
   out.p.z = z;
-  // maxAbsComponent's order of comparisons, so that a NaN coordinate gives the same bound.
-  out.error = roundingErrorBound(std::max(std::fabs(x), std::max(std::fabs(y), std::fabs(z))) + size);
+  out.error = roundingErrorBound(maxAbsComponent(out.p) + size);
   return out;
 }
 inline SurfacePoint roundedPoint(const glm::dvec3& p, float size = 0.0f) {

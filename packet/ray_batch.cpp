@@ -158,10 +158,7 @@ bool ClosestHitBatch::hit(size_t i, RawHit& out) const {
   out.t = RTCRayN_tfar(RTCRayHitN_RayN(p, n), n, lane);
   out.geomID = RTCHitN_geomID(h, n, lane);
   out.primID = RTCHitN_primID(h, n, lane);
-  // Two floats per store where a reader copies two at a time (Scene::surfaceHit copies uv and
-  // ng.xy as 8-byte words): a wide load of narrower, just-made stores waits until they reach the
-  // cache instead of taking their values (store-to-load forwarding fails), which `perf annotate`
-  // showed as a third of surfaceHit's time on an AVX-512 Xeon.
+  // uv and ng.xy as 8-byte stores, the width Scene::surfaceHit reads them at (RawHit's comment).
   storePair(&out.uv, RTCHitN_u(h, n, lane), RTCHitN_v(h, n, lane));
   storePair(&out.ng, RTCHitN_Ng_x(h, n, lane), RTCHitN_Ng_y(h, n, lane));
   out.ng.z = RTCHitN_Ng_z(h, n, lane);
