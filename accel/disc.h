@@ -49,6 +49,7 @@ class Disc final : public Shape {
     return disc_.projectToSurface(p);
   }
   float area() const override { return disc_.area(); }
+  bool flat() const override { return true; }
   ShapeSample sampleArea(Vec2 u) const override { return disc_.sampleArea(u); }
 
  private:

@@ -33,7 +33,7 @@ EmbreeAccel::~EmbreeAccel() {
   if (device_) rtcReleaseDevice(device_);
 }
 
-uint32_t EmbreeAccel::addShape(const Shape* shape, bool needsUv) {
+uint32_t EmbreeAccel::addShape(const Shape* shape, bool needsUv, uint32_t mask) {
   RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
   rtcSetGeometryUserPrimitiveCount(geom, 1);
   shapes_.push_back(std::make_unique<ShapeGeometry>(ShapeGeometry{shape, needsUv}));
@@ -41,6 +41,7 @@ uint32_t EmbreeAccel::addShape(const Shape* shape, bool needsUv) {
   rtcSetGeometryBoundsFunction(geom, shapeBoundsCallback, nullptr);
   rtcSetGeometryIntersectFunction(geom, shapeIntersectCallback);
   rtcSetGeometryOccludedFunction(geom, shapeOccludedCallback);
+  rtcSetGeometryMask(geom, mask);
   rtcCommitGeometry(geom);
   const uint32_t id = rtcAttachGeometry(scene_, geom);
   rtcReleaseGeometry(geom);
@@ -97,7 +98,7 @@ void EmbreeAccel::commit() {
     throw std::runtime_error("Embree failed to build the scene (error " + std::to_string(int(err)) + ")");
 }
 
-static RTCRay toRtc(const Ray& ray, float tMin) {
+static RTCRay toRtc(const Ray& ray, float tMin, uint32_t mask = EmbreeAccel::kAllMask) {
   RTCRay r;
   r.org_x = ray.origin.x;
   r.org_y = ray.origin.y;
@@ -108,18 +109,18 @@ static RTCRay toRtc(const Ray& ray, float tMin) {
   r.dir_z = ray.dir.z;
   r.time = 0.0f;
   r.tfar = ray.tMax;
-  r.mask = 0xFFFFFFFFu;  // Debian's Embree is built with ray masks: 0 would miss everything
+  r.mask = mask;  // Debian's Embree is built with ray masks: 0 would miss everything
   r.id = 0;
   r.flags = 0;
   return r;
 }
 
-bool EmbreeAccel::intersect(const Ray& ray, RawHit& hit) const {
+bool EmbreeAccel::intersect(const Ray& ray, RawHit& hit, uint32_t mask) const {
   if (!traceable(ray)) return false;
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRayHit rh;
-  rh.ray = toRtc(ray, 0.0f);
+  rh.ray = toRtc(ray, 0.0f, mask);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
@@ -133,11 +134,11 @@ bool EmbreeAccel::intersect(const Ray& ray, RawHit& hit) const {
   return true;
 }
 
-bool EmbreeAccel::occluded(const Ray& ray, float tMin) const {
+bool EmbreeAccel::occluded(const Ray& ray, float tMin, uint32_t mask) const {
   if (!traceable(ray)) return false;
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  RTCRay r = toRtc(ray, tMin);
+  RTCRay r = toRtc(ray, tMin, mask);
   rtcOccluded1(scene_, &context, &r);
   return r.tfar < 0.0f;
 }

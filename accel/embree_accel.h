@@ -51,15 +51,19 @@ class EmbreeAccel {
   EmbreeAccel(const EmbreeAccel&) = delete;
   EmbreeAccel& operator=(const EmbreeAccel&) = delete;
 
+  // Rays whose mask shares no bit with a geometry's skip it. Every ray and geometry has all bits
+  // set but shadow rays aimed at a flat emitter and that emitter (Shape::flat, Light::shadowMask).
+  static constexpr uint32_t kAllMask = 0xFFFFFFFFu;
+
   // The pointers must outlive this object. `needsUv`: whether the shape's hits need texture
   // coordinates (accel/shape_lanes.h, RayLanes::needsUv).
-  uint32_t addShape(const Shape* shape, bool needsUv = true);
+  uint32_t addShape(const Shape* shape, bool needsUv = true, uint32_t mask = kAllMask);
   uint32_t addMesh(const TriangleMesh* mesh);
   void commit();
 
-  bool intersect(const Ray& ray, RawHit& hit) const;
+  bool intersect(const Ray& ray, RawHit& hit, uint32_t mask = kAllMask) const;
   // True when something blocks the open segment (tMin, tMax) of the ray.
-  bool occluded(const Ray& ray, float tMin = 0.0f) const;
+  bool occluded(const Ray& ray, float tMin = 0.0f, uint32_t mask = kAllMask) const;
 
   Bounds bounds() const;
   const char* isaName() const;

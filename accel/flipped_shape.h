@@ -36,6 +36,7 @@ class FlippedShape final : public Shape {
     return inner_->projectToSurface(p, original);
   }
   float area() const override { return inner_->area(); }
+  bool flat() const override { return inner_->flat(); }
   ShapeSample sampleArea(Vec2 u) const override {
     ShapeSample s = inner_->sampleArea(u);
     s.n = -s.n;

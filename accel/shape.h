@@ -79,6 +79,13 @@ class Shape {
 
   virtual float area() const = 0;
 
+  // Whether the whole shape lies in one plane. A ray leaving such a shape (its origin pushed off
+  // the plane to the side it travels to, core/ray_spawn.h) never meets it again, and neither does a
+  // shadow ray aimed at one of its points (stopped short of the plane): Scene gives flat shapes an
+  // Embree mask bit of their own, which those rays leave out (SurfaceHit::rayMask,
+  // Light::shadowMask), so Embree skips their test.
+  virtual bool flat() const { return false; }
+
   // A point distributed uniformly by area over the whole surface (density 1 / area()).
   virtual ShapeSample sampleArea(Vec2 u) const = 0;
 

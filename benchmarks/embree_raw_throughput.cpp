@@ -3,7 +3,8 @@
 // closest-hit rays starting on surfaces inside the box, and shadow rays from those points to the
 // area light — as single rays (rtcIntersect1/rtcOccluded1) and as 8- and 16-wide packets, on 1 and
 // on all threads. The scene is Ember's own (analytic user geometry), so the numbers include the
-// cost of our intersection callbacks, exactly as Ember pays it.
+// cost of our intersection callbacks, exactly as Ember pays it, and the rays carry the Embree masks
+// Ember's own carry (Shape::flat).
 //   embree_raw_throughput [scene.json] [--rays N] [--mix-only]
 // --mix-only measures the two vertex-mix rows alone (the limit), for benchmarks/limit_fraction.py.
 #include "core/sampling.h"
@@ -28,6 +29,9 @@ struct RayBatch {
   std::vector<Ray> closest;
   std::vector<Ray> shadow;
   std::vector<float> shadowDist;
+  // The Embree masks Ember's own rays carry (Shape::flat): a closest-hit ray skips the flat shape
+  // it leaves, a shadow ray that one and the light it is aimed at.
+  std::vector<uint32_t> closestMask, shadowMask;
 };
 
 // Path-tracer-like rays: start at the first hit of a random camera ray, continue in a cosine
@@ -36,6 +40,8 @@ RayBatch makeRays(const Scene& scene, size_t n) {
   RayBatch b;
   Rng rng(11, 1);
   const Vec3 lightCenter(0.0f, 1.98f, 0.0f);
+  uint32_t lightMask = EmbreeAccel::kAllMask;  // the scene's one light's Light::shadowMask
+  for (const auto& light : scene.lights) lightMask &= light->shadowMask;
   while (b.closest.size() < n) {
     const Ray cam = scene.camera().generateRay(rng.uniform() * 256.0f, rng.uniform() * 256.0f);
     SurfaceHit hit;
@@ -43,6 +49,8 @@ RayBatch makeRays(const Scene& scene, size_t n) {
     const Vec3 n0 = glm::dot(hit.ng, cam.dir) < 0.0f ? hit.ng : -hit.ng;
     const Vec3 dir = Frame(n0).toWorld(sampleCosineHemisphere(Vec2(rng.uniform(), rng.uniform())));
     b.closest.push_back(Ray{hit.offsetOrigin(dir), dir});
+    b.closestMask.push_back(hit.rayMask);
+    b.shadowMask.push_back(hit.rayMask & lightMask);
     const Vec3 target = lightCenter + Vec3(rng.uniform() - 0.5f, 0.0f, rng.uniform() - 0.5f) * 0.5f;
     b.shadow.push_back(spawnRayTo(hit.p, hit.ng, hit.pError, target, Vec3(0.0f, -1.0f, 0.0f),
                                   roundingErrorBound(maxAbsComponent(target))));
@@ -52,7 +60,7 @@ RayBatch makeRays(const Scene& scene, size_t n) {
 }
 
 template <int N, typename Packet>
-void fillPacket(Packet& p, const Ray* rays, const float* tfar) {
+void fillPacket(Packet& p, const Ray* rays, const float* tfar, const uint32_t* masks) {
   for (int i = 0; i < N; ++i) {
     p.org_x[i] = rays[i].origin.x;
     p.org_y[i] = rays[i].origin.y;
@@ -63,7 +71,7 @@ void fillPacket(Packet& p, const Ray* rays, const float* tfar) {
     p.tnear[i] = 0.0f;
     p.tfar[i] = tfar ? tfar[i] : kInfinity;
     p.time[i] = 0.0f;
-    p.mask[i] = 0xFFFFFFFFu;
+    p.mask[i] = masks[i];
     p.id[i] = unsigned(i);
     p.flags[i] = 0;
   }
@@ -113,11 +121,11 @@ int run(int argc, char** argv) {
   row("incoherent closest-hit, single", [&](size_t lo, size_t hi) {
     for (size_t i = lo; i < hi; ++i) {
       SurfaceHit h;
-      scene.intersect(b.closest[i], h);
+      scene.intersect(b.closest[i], h, b.closestMask[i]);
     }
   });
   row("shadow to light, single", [&](size_t lo, size_t hi) {
-    for (size_t i = lo; i < hi; ++i) scene.occluded(b.shadow[i]);
+    for (size_t i = lo; i < hi; ++i) scene.occluded(b.shadow[i], b.shadowMask[i]);
   });
   row("incoherent closest-hit, 8-wide", [&](size_t lo, size_t hi) {
     RTCIntersectContext ctx;
@@ -126,7 +134,7 @@ int run(int argc, char** argv) {
     std::fill(valid, valid + 8, -1);
     for (size_t i = lo; i + 8 <= hi; i += 8) {
       alignas(32) RTCRayHit8 rh;
-      fillPacket<8>(rh.ray, &b.closest[i], nullptr);
+      fillPacket<8>(rh.ray, &b.closest[i], nullptr, &b.closestMask[i]);
       std::fill(rh.hit.geomID, rh.hit.geomID + 8, RTC_INVALID_GEOMETRY_ID);
       rtcIntersect8(valid, rtc, &ctx, &rh);
     }
@@ -138,7 +146,7 @@ int run(int argc, char** argv) {
     std::fill(valid, valid + 16, -1);
     for (size_t i = lo; i + 16 <= hi; i += 16) {
       alignas(64) RTCRayHit16 rh;
-      fillPacket<16>(rh.ray, &b.closest[i], nullptr);
+      fillPacket<16>(rh.ray, &b.closest[i], nullptr, &b.closestMask[i]);
       std::fill(rh.hit.geomID, rh.hit.geomID + 16, RTC_INVALID_GEOMETRY_ID);
       rtcIntersect16(valid, rtc, &ctx, &rh);
     }
@@ -150,7 +158,7 @@ int run(int argc, char** argv) {
     std::fill(valid, valid + 16, -1);
     for (size_t i = lo; i + 16 <= hi; i += 16) {
       alignas(64) RTCRay16 r;
-      fillPacket<16>(r, &b.shadow[i], &b.shadowDist[i]);
+      fillPacket<16>(r, &b.shadow[i], &b.shadowDist[i], &b.shadowMask[i]);
       rtcOccluded16(valid, rtc, &ctx, &r);
     }
   });
@@ -166,11 +174,11 @@ int run(int argc, char** argv) {
         const size_t end = std::min(hi, i + 256);
         if (shadow) {
           shadows.clear();
-          for (size_t k = i; k < end; ++k) shadows.push(b.shadow[k]);
+          for (size_t k = i; k < end; ++k) shadows.push(b.shadow[k], b.shadowMask[k]);
           shadows.trace(scene.accel(), traversal);
         } else {
           closest.clear();
-          for (size_t k = i; k < end; ++k) closest.push(b.closest[k]);
+          for (size_t k = i; k < end; ++k) closest.push(b.closest[k], b.closestMask[k]);
           closest.trace(scene.accel(), traversal);
           for (size_t k = 0; k < closest.size(); ++k) closest.hit(k, raw);
         }
@@ -185,8 +193,8 @@ int run(int argc, char** argv) {
   row("vertex mix (1 closest + 1 shadow)", [&](size_t lo, size_t hi) {
     for (size_t i = lo; i < hi; ++i) {
       SurfaceHit h;
-      scene.intersect(b.closest[i], h);
-      scene.occluded(b.shadow[i]);
+      scene.intersect(b.closest[i], h, b.closestMask[i]);
+      scene.occluded(b.shadow[i], b.shadowMask[i]);
     }
   });
   row("vertex mix, batches of packets", [&](size_t lo, size_t hi) {
@@ -198,8 +206,8 @@ int run(int argc, char** argv) {
       closest.clear();
       shadows.clear();
       for (size_t k = i; k < end; ++k) {
-        closest.push(b.closest[k]);
-        shadows.push(b.shadow[k]);
+        closest.push(b.closest[k], b.closestMask[k]);
+        shadows.push(b.shadow[k], b.shadowMask[k]);
       }
       closest.trace(scene.accel());
       for (size_t k = 0; k < closest.size(); ++k) closest.hit(k, raw);

@@ -19,8 +19,11 @@ struct SurfaceHit {
   float t = 0.0f;
   float pError = roundingErrorBound(0.0f);  // rounding-error bound of p (core/ray_spawn.h)
   const Material* material = nullptr;
-  const Light* light = nullptr;   // the area light this surface belongs to, if it emits
-  Color emission{0.0f};           // radiance emitted on the side of ng
+  const Light* light = nullptr;  // the area light this surface belongs to, if it emits
+  Color emission{0.0f};          // radiance emitted on the side of ng
+  // The Embree ray mask of rays leaving the surface: every bit but its own shape's where that is
+  // flat (Shape::flat), since they cannot meet it again; every bit otherwise.
+  uint32_t rayMask = 0xFFFFFFFFu;
   bool twoSidedEmission = false;  // emits on both sides (glTF doubleSided)
 
   // Radiance the surface emits towards direction w: only on the side of ng unless two-sided.

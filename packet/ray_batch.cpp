@@ -41,7 +41,8 @@ void storePair(void* field, float a, float b) {
 }
 static_assert(sizeof(Vec2) == 2 * sizeof(float) && sizeof(Vec3) == 3 * sizeof(float));
 
-// The fields no ray changes, written once per packet when the layout is set.
+// The fields no ray changes, written once per packet when the layout is set, and the mask, which
+// each push then sets for its ray.
 void initFixedFields(RTCRayN* p, unsigned n) {
   for (unsigned lane = 0; lane < n; ++lane) {
     RTCRayN_time(p, n, lane) = 0.0f;
@@ -113,11 +114,12 @@ void PacketStorage::setWidth(unsigned width) {
 ClosestHitBatch::ClosestHitBatch(size_t capacity, unsigned width)
     : storage_(capacity, kFloatsPerRayHit, width) {}
 
-void ClosestHitBatch::push(const Ray& ray) {
+void ClosestHitBatch::push(const Ray& ray, uint32_t mask) {
   if (size_ == storage_.capacity()) throw std::logic_error("ClosestHitBatch overflow");
   const unsigned n = storage_.width(), lane = storage_.laneOf(size_);
   RTCRayHitN* p = packetOf(size_);
   writeRay(RTCRayHitN_RayN(p, n), n, lane, ray);
+  RTCRayN_mask(RTCRayHitN_RayN(p, n), n, lane) = mask;
   RTCHitN* h = RTCRayHitN_HitN(p, n);
   RTCHitN_geomID(h, n, lane) = RTC_INVALID_GEOMETRY_ID;
   RTCHitN_primID(h, n, lane) = RTC_INVALID_GEOMETRY_ID;
@@ -167,10 +169,12 @@ bool ClosestHitBatch::hit(size_t i, RawHit& out) const {
 
 ShadowBatch::ShadowBatch(size_t capacity, unsigned width) : storage_(capacity, kFloatsPerRay, width) {}
 
-void ShadowBatch::push(const Ray& ray) {
+void ShadowBatch::push(const Ray& ray, uint32_t mask) {
   if (size_ == storage_.capacity()) throw std::logic_error("ShadowBatch overflow");
-  writeRay(reinterpret_cast<RTCRayN*>(storage_.packetOf(size_)), storage_.width(), storage_.laneOf(size_),
-           ray);
+  auto* packet = reinterpret_cast<RTCRayN*>(storage_.packetOf(size_));
+  const unsigned n = storage_.width(), lane = storage_.laneOf(size_);
+  writeRay(packet, n, lane, ray);
+  RTCRayN_mask(packet, n, lane) = mask;
   ++size_;
 }
 

@@ -68,7 +68,8 @@ class ClosestHitBatch {
   size_t size() const { return size_; }
   size_t capacity() const { return storage_.capacity(); }
   // Appends a ray (tnear 0, tfar ray.tMax); its index is the size before the call.
-  void push(const Ray& ray);
+  // `mask`: the ray's Embree mask (all bits, or the SurfaceHit::rayMask of the surface it leaves).
+  void push(const Ray& ray, uint32_t mask = 0xFFFFFFFFu);
   void trace(const EmbreeAccel& accel, BatchTraversal traversal = BatchTraversal::Packets);
   // The closest hit of ray i, as EmbreeAccel::intersect reports it; false if it hit nothing.
   bool hit(size_t i, RawHit& out) const;
@@ -102,8 +103,9 @@ class ShadowBatch {
   unsigned width() const { return storage_.width(); }
   void clear() { size_ = 0; }
   size_t size() const { return size_; }
-  // Appends a ray blocked by anything on its open segment (0, ray.tMax).
-  void push(const Ray& ray);
+  // Appends a ray blocked by anything on its open segment (0, ray.tMax) whose Embree mask shares
+  // a bit with `mask` (EmbreeAccel::kAllMask, or a light's shadowMask).
+  void push(const Ray& ray, uint32_t mask = 0xFFFFFFFFu);
   void trace(const EmbreeAccel& accel, BatchTraversal traversal = BatchTraversal::Packets);
   bool occluded(size_t i) const {
     return RTCRayN_tfar(reinterpret_cast<RTCRayN*>(storage_.packetOf(i)), storage_.width(),

@@ -175,7 +175,7 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
                                       wave.querySampled[size_t(q)], stats, shadow)) {
           wave.shadowOwner[wave.shadows.size()] = wave.vertexLane[v];
           wave.shadowContribution[wave.shadows.size()] = shadow.contribution;
-          wave.shadows.push(shadow.ray);
+          wave.shadows.push(shadow.ray, shadow.mask);
         }
         wave.bsdfs.hit[v] = &wave.hits[v];
         wave.bsdfs.wo[v] = -lane.path.ray.dir;
@@ -190,7 +190,7 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
         if (path_.followBsdfSample(lane.path, wave.hits[v], wave.bsdfs.sample[v], wave.bsdfs.sampled[v],
                                    lane.sampler)) {
           wave.next[next++] = wave.vertexLane[v];
-          wave.closest.push(lane.path.ray);
+          wave.closest.push(lane.path.ray, lane.path.rayMask);
         }
       }
 

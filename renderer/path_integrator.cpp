@@ -42,6 +42,7 @@ bool PathIntegrator::shadowFor(const SurfaceHit& hit, const PathState& path, con
   const float lightPdf = pick.pmf * ls.pdf;
   const float weight = ls.delta || strategy_ == Strategy::Light ? 1.0f : powerHeuristic(lightPdf, bsdfPdf);
   shadow.contribution = path.throughput * (f * ls.Li * (weight / lightPdf));
+  shadow.mask = hit.rayMask & pick.light->shadowMask;
   ++stats.shadowRays;
   return true;
 }
@@ -141,6 +142,7 @@ bool PathIntegrator::followBsdfSample(PathState& path, const SurfaceHit& hit, co
   if (path.depth == 1) path.firstBounceNonDelta = !bs.delta;
   path.etaProduct *= bs.eta;
   path.ray = Ray{hit.offsetOrigin(bs.wi), bs.wi};
+  path.rayMask = hit.rayMask;
 
   if (path.depth >= rrDepth_) {
     const float q = std::min(maxComponent(path.throughput) * path.etaProduct * path.etaProduct, 0.95f);
@@ -157,13 +159,14 @@ Color PathIntegrator::Li(const Scene& scene, Ray ray, Sampler& sampler, PathStat
   for (;;) {
     SurfaceHit hit;
     ++stats.rays;
-    if (!scene.intersect(path.ray, hit)) {
+    if (!scene.intersect(path.ray, hit, path.rayMask)) {
       onMiss(scene, path);
       break;
     }
     ShadowRequest shadow;
     bool continues;
-    if (onHit(scene, path, hit, sampler, stats, shadow, continues) && !scene.occluded(shadow.ray))
+    if (onHit(scene, path, hit, sampler, stats, shadow, continues) &&
+        !scene.occluded(shadow.ray, shadow.mask))
       path.radiance += shadow.contribution;
     if (!continues) break;
   }

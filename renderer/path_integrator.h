@@ -39,6 +39,8 @@ struct PathState {
   bool previousDelta = true;  // camera rays count as specular: emitters they see get weight 1
   float previousPdf = 0.0f;
   Vec3 previousPoint{0.0f};
+  // The Embree mask of `ray`: the SurfaceHit::rayMask of the surface it leaves.
+  uint32_t rayMask = 0xFFFFFFFFu;
   int depth = 1;                     // segments cast so far, counting the one in flight
   bool firstBounceNonDelta = false;  // the camera vertex scattered through a non-Dirac lobe
 };
@@ -48,6 +50,7 @@ struct PathState {
 struct ShadowRequest {
   Ray ray;
   Color contribution;
+  uint32_t mask;  // the surface's rayMask and the light's shadowMask
 };
 
 // The light next-event estimation chose at a vertex, with the random numbers for its sample.

@@ -51,17 +51,30 @@ void Scene::build() {
   std::vector<Light*> allLights;
   for (auto& light : lights) allLights.push_back(light.get());
 
-  for (ShapeEntry& entry : shapes) {
+  // Embree has 32 mask bits: each goes to one flat shape (Shape::flat), emitters first (their
+  // shadow rays skip them too), and any flat shapes past the 32nd are tested as before.
+  std::vector<uint32_t> ownBits(shapes.size(), 0u);
+  unsigned maskBits = 0;
+  for (const bool emitters : {true, false})
+    for (size_t i = 0; i < shapes.size(); ++i)
+      if (maskBits < 32 && !isBlack(shapes[i].emission) == emitters && shapes[i].shape->flat())
+        ownBits[i] = 1u << maskBits++;
+  for (size_t i = 0; i < shapes.size(); ++i) {
+    ShapeEntry& entry = shapes[i];
     // Analytic shapes have no surface maps and AreaLight's radiance is uniform, so the material
     // is the only reader of their UV (were emission textures added, they would read it too).
     const bool readsUv = !entry.material || entry.material->readsUv();
-    const uint32_t id = accel_->addShape(entry.shape.get(), readsUv);
+    const bool emits = !isBlack(entry.emission);
+    const uint32_t ownBit = ownBits[i];
+    const uint32_t id = accel_->addShape(entry.shape.get(), readsUv, ownBit ? ownBit : EmbreeAccel::kAllMask);
     GeometryRecord rec{entry.shape.get(), nullptr,        entry.material,
                        nullptr,           entry.emission, entry.twoSidedEmission};
     rec.readsUv = readsUv;
-    if (!isBlack(entry.emission)) {
+    rec.rayMask = ~ownBit;
+    if (emits) {
       lights.push_back(
           std::make_unique<AreaLight>(entry.shape.get(), entry.emission, entry.twoSidedEmission));
+      lights.back()->shadowMask = ~ownBit;
       allLights.push_back(lights.back().get());
       rec.light = lights.back().get();
     }
@@ -126,9 +139,9 @@ void Scene::build() {
     light->causticTraced = causticTracer_.enabled() && dynamic_cast<const AreaLight*>(light.get());
 }
 
-bool Scene::intersect(const Ray& ray, SurfaceHit& hit) const {
+bool Scene::intersect(const Ray& ray, SurfaceHit& hit, uint32_t mask) const {
   RawHit raw;
-  if (!accel_->intersect(ray, raw)) return false;
+  if (!accel_->intersect(ray, raw, mask)) return false;
   surfaceHit(ray, raw, hit);
   return true;
 }
@@ -172,6 +185,7 @@ void Scene::surfaceHit(const Ray& ray, const RawHit& raw, SurfaceHit& hit) const
       rec.firstTriangleLight >= 0 ? triangleLights_[size_t(rec.firstTriangleLight) + raw.primID] : rec.light;
   hit.emission = rec.emission;
   hit.twoSidedEmission = rec.twoSidedEmission;
+  hit.rayMask = rec.rayMask;
   if (rec.maps && rec.maps->emission && !isBlack(rec.emission))
     hit.emission *= rec.maps->emission->eval(hit.uv);
 }
@@ -197,8 +211,8 @@ void Scene::prefetchVertices(uint32_t geomID, uint32_t primID) const {
   }
 }
 
-bool Scene::occluded(const Ray& ray) const {
-  return accel_->occluded(ray);
+bool Scene::occluded(const Ray& ray, uint32_t mask) const {
+  return accel_->occluded(ray, 0.0f, mask);
 }
 
 size_t Scene::triangleCount() const {

@@ -77,7 +77,8 @@ class Scene {
   void build();
   bool built() const { return accel_ != nullptr; }
 
-  bool intersect(const Ray& ray, SurfaceHit& hit) const;
+  // `mask`: the Embree ray mask (all bits, or the SurfaceHit::rayMask of the surface it leaves).
+  bool intersect(const Ray& ray, SurfaceHit& hit, uint32_t mask = 0xFFFFFFFFu) const;
   // The full record of a hit the accelerator found for `ray` (alone or in a batch).
   void surfaceHit(const Ray& ray, const RawHit& raw, SurfaceHit& hit) const;
   // Geometries in the acceleration structure: every geomID is below this.
@@ -95,7 +96,8 @@ class Scene {
   void prefetchTriangle(uint32_t geomID, uint32_t primID) const;
   void prefetchVertices(uint32_t geomID, uint32_t primID) const;
   // True when something blocks the ray before ray.tMax (a shadow ray from core/ray_spawn.h).
-  bool occluded(const Ray& ray) const;
+  // `mask`: the Embree ray mask (all bits, or a surface's rayMask and a light's shadowMask).
+  bool occluded(const Ray& ray, uint32_t mask = 0xFFFFFFFFu) const;
 
   const Camera& camera() const { return camera_; }
   const LightSampler& lightSampler() const { return lightSampler_; }
@@ -120,6 +122,7 @@ class Scene {
     const SurfaceMaps* maps = nullptr;
     int64_t firstTriangleLight = -1;  // emissive meshes: index of primitive 0's light in triangleLights_
     bool readsUv = true;              // whether the material reads the hit's texture coordinates
+    uint32_t rayMask = 0xFFFFFFFFu;   // SurfaceHit::rayMask of its hits
   };
 
   std::vector<CausticCaster> findCausticCasters() const;
