@@ -99,7 +99,7 @@ void traceCausticsInWaves(const Scene& scene, int maxDepth, int rrDepth, uint64_
           if (tracer.startWith(wave.emission[i], int((range.begin() + i) / paths), pathsPerPixel, maxDepth,
                                lane.path)) {
             wave.active[active++] = uint16_t(i);
-            wave.closest.push(lane.path.ray);
+            wave.closest.push(lane.path.ray, lane.path.rayMask);
           }
         }
         while (active > 0) {
@@ -123,7 +123,7 @@ void traceCausticsInWaves(const Scene& scene, int maxDepth, int rrDepth, uint64_
             bool scatters;
             if (tracer.connect(scene, maxDepth, lane.path, hit, splat, scatters)) {
               wave.splatImage[wave.shadows.size()] = lane.path.index;
-              wave.shadows.push(splat.ray);
+              wave.shadows.push(splat.ray, splat.mask);
             }
             if (!scatters) continue;
             wave.vertexLane[vertices] = wave.active[a];
@@ -141,7 +141,7 @@ void traceCausticsInWaves(const Scene& scene, int maxDepth, int rrDepth, uint64_
             if (tracer.follow(rrDepth, lane.path, wave.hits[v], wave.bsdfs.wo[v], wave.bsdfs.sample[v],
                               wave.bsdfs.sampled[v], lane.sampler)) {
               wave.next[next++] = wave.vertexLane[v];
-              wave.closest.push(lane.path.ray);
+              wave.closest.push(lane.path.ray, lane.path.rayMask);
             }
           }
           local.shadowRays += wave.shadows.size();

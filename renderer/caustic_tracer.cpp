@@ -146,33 +146,33 @@ void CausticTracer::traceAlone(const Scene& scene, int maxDepth, int rrDepth, ui
   const uint64_t paths = batch.paths;
   const float pathsPerPixel = batch.pathsPerPixel;
   std::mutex statsMutex;
-  tbb::parallel_for(
-      tbb::blocked_range<uint64_t>(0, paths * uint64_t(count), kPathsPerTask),
-      [&](const tbb::blocked_range<uint64_t>& range) {
-        // As in the tile tasks: the same floating-point mode on every thread.
-        _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
-        _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
-        PathStats local;
-        for (uint64_t k = range.begin(); k != range.end(); ++k) {
-          const uint64_t index = k / paths;
-          Sampler sampler = samplerFor(type, seed, k % paths, firstIndex + index);
-          PathState path;
-          if (!start(sampler, int(index), pathsPerPixel, maxDepth, path)) continue;
-          for (bool continues = true; continues;) {
-            SurfaceHit hit;
-            ++local.rays;
-            if (!scene.intersect(path.ray, hit)) break;
-            Splat splat;
-            if (onHit(scene, maxDepth, rrDepth, path, hit, sampler, splat, continues)) {
-              ++local.shadowRays;
-              if (!scene.occluded(splat.ray) && !splats.add(path.index, splat.x, splat.y, splat.value))
-                ++local.nonFinite;
-            }
-          }
-        }
-        std::lock_guard<std::mutex> lock(statsMutex);
-        stats += local;
-      });
+  tbb::parallel_for(tbb::blocked_range<uint64_t>(0, paths * uint64_t(count), kPathsPerTask),
+                    [&](const tbb::blocked_range<uint64_t>& range) {
+                      // As in the tile tasks: the same floating-point mode on every thread.
+                      _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+                      _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+                      PathStats local;
+                      for (uint64_t k = range.begin(); k != range.end(); ++k) {
+                        const uint64_t index = k / paths;
+                        Sampler sampler = samplerFor(type, seed, k % paths, firstIndex + index);
+                        PathState path;
+                        if (!start(sampler, int(index), pathsPerPixel, maxDepth, path)) continue;
+                        for (bool continues = true; continues;) {
+                          SurfaceHit hit;
+                          ++local.rays;
+                          if (!scene.intersect(path.ray, hit, path.rayMask)) break;
+                          Splat splat;
+                          if (onHit(scene, maxDepth, rrDepth, path, hit, sampler, splat, continues)) {
+                            ++local.shadowRays;
+                            const bool blocked = scene.occluded(splat.ray, splat.mask);
+                            if (!blocked && !splats.add(path.index, splat.x, splat.y, splat.value))
+                              ++local.nonFinite;
+                          }
+                        }
+                      }
+                      std::lock_guard<std::mutex> lock(statsMutex);
+                      stats += local;
+                    });
 }
 
 bool CausticTracer::start(Sampler& sampler, int index, float pathsPerPixel, int maxDepth,
@@ -206,6 +206,7 @@ bool CausticTracer::startWith(const EmissionNumbers& u, int index, float pathsPe
   path.index = index;
   path.pathsPerPixel = pathsPerPixel;
   path.ray = Ray{offsetAlongNormal(y.p, y.n, light.pointError(), dir), dir};
+  path.rayMask = light.shadowMask;  // leaving the light, it cannot meet a flat one again
   return true;
 }
 
@@ -253,6 +254,7 @@ bool CausticTracer::connect(const Scene& scene, int maxDepth, PathState& path, c
       const float we =
           1.0f / (camera.imagePlaneArea() * cosCamera * cosCamera * cosCamera * dist2 * path.pathsPerPixel);
       splat.ray = spawnRayTo(hit.p, hit.ng, hit.pError, camera.origin(), Vec3(0.0f), 0.0f);
+      splat.mask = hit.rayMask;
       splat.x = std::min(int(raster.x), camera.width() - 1);
       splat.y = std::min(int(raster.y), camera.height() - 1);
       splat.value = path.beta * f * we;
@@ -281,6 +283,7 @@ bool CausticTracer::follow(int rrDepth, PathState& path, const SurfaceHit& hit, 
     path.scattering /= q;
   }
   path.ray = Ray{hit.offsetOrigin(bs.wi), bs.wi};
+  path.rayMask = hit.rayMask;
   ++path.segments;
   return true;
 }
