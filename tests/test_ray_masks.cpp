@@ -81,6 +81,20 @@ TEST(RayMasks, FlatShapesHaveBitsOfTheirOwnEmittersFirst) {
   EXPECT_EQ(onBall.rayMask, 0xFFFFFFFFu);  // curved: a ray leaving it may meet it again
 }
 
+// What makes the equality below meaningful: Embree does skip a shape for a ray whose mask leaves
+// out its bit (Debian's Embree is built with ray masks).
+TEST(RayMasks, ARaySkipsTheShapeItsMaskLeavesOut) {
+  const Scene scene = stackedQuads();
+  const uint32_t layer5 = hitOnLayer(scene, 5, 0.0f, 0.0f).rayMask;
+  const Ray down{Vec3(0.0f, 5.5f * kSpacing, 0.0f), Vec3(0.0f, -1.0f, 0.0f)};
+  SurfaceHit hit;
+  ASSERT_TRUE(scene.intersect(down, hit, layer5));
+  EXPECT_NEAR(hit.p.y, 4.0f * kSpacing, 1e-6f);  // through layer 5 to layer 4
+  const Ray toLight{Vec3(0.0f, kLightY - 0.25f, 0.0f), Vec3(0.0f, 1.0f, 0.0f), 1.0f};
+  EXPECT_TRUE(scene.occluded(toLight));
+  EXPECT_FALSE(scene.occluded(toLight, areaLight(scene).shadowMask));
+}
+
 TEST(RayMasks, OnlyShapesInOnePlaneAreFlat) {
   EXPECT_TRUE(horizontalQuad(0.0f, 1.0f)->flat());
   EXPECT_TRUE(
