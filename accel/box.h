@@ -19,6 +19,7 @@ class Box final : public Shape {
   void intersectLanes(const RayLanes& rays, LaneHits& out) const override;
   SurfacePoint projectToSurface(const Vec3& p, const LocalHit& hit) const override;
   float area() const override;
+  int convexSide() const override { return 1; }
   ShapeSample sampleArea(Vec2 u) const override;
 
  private:

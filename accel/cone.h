@@ -20,6 +20,7 @@ class Cone final : public Shape {
   Vec2 surfaceUv(const LocalHit& hit) const override;
   SurfacePoint projectToSurface(const Vec3& p, const LocalHit& hit) const override;
   float area() const override;
+  int convexSide() const override { return 1; }
   ShapeSample sampleArea(Vec2 u) const override;
 
  private:

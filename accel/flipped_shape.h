@@ -37,6 +37,7 @@ class FlippedShape final : public Shape {
   }
   float area() const override { return inner_->area(); }
   bool flat() const override { return inner_->flat(); }
+  int convexSide() const override { return -inner_->convexSide(); }
   ShapeSample sampleArea(Vec2 u) const override {
     ShapeSample s = inner_->sampleArea(u);
     s.n = -s.n;

@@ -85,6 +85,12 @@ class Shape {
   // Embree mask bit of their own, which those rays leave out (SurfaceHit::rayMask,
   // Light::shadowMask), so Embree skips their test.
   virtual bool flat() const { return false; }
+  // +1 when the shape lies on the boundary of a convex solid and its normals point out of it
+  // (sphere, box, cylinder and cone, capped or not): a ray leaving it to the side of its normal
+  // starts in front of a plane that has the whole solid behind it, and never meets the shape
+  // again. -1 when its normals point into such a solid (a FlippedShape of one); 0 otherwise.
+  // Scene masks these out of the rays that leave them that way, as it does flat shapes.
+  virtual int convexSide() const { return 0; }
 
   // A point distributed uniformly by area over the whole surface (density 1 / area()).
   virtual ShapeSample sampleArea(Vec2 u) const = 0;

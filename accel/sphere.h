@@ -23,6 +23,7 @@ class Sphere final : public Shape {
   Vec2 surfaceUv(const LocalHit& hit) const override;
   SurfacePoint projectToSurface(const Vec3& p, const LocalHit& hit) const override;
   float area() const override { return 4.0f * kPi * radius_ * radius_; }
+  int convexSide() const override { return 1; }
   ShapeSample sampleArea(Vec2 u) const override;
   bool sampleSolidAngle(const Vec3& ref, Vec2 u, ShapeSample& s, float& pdf) const override;
   float pdfSolidAngle(const Vec3& ref, const Vec3& p, const Vec3& n) const override;

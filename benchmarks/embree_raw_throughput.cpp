@@ -49,12 +49,12 @@ RayBatch makeRays(const Scene& scene, size_t n) {
     const Vec3 n0 = glm::dot(hit.ng, cam.dir) < 0.0f ? hit.ng : -hit.ng;
     const Vec3 dir = Frame(n0).toWorld(sampleCosineHemisphere(Vec2(rng.uniform(), rng.uniform())));
     b.closest.push_back(Ray{hit.offsetOrigin(dir), dir});
-    b.closestMask.push_back(hit.rayMask);
-    b.shadowMask.push_back(hit.rayMask & lightMask);
+    b.closestMask.push_back(hit.rayMask(dir));
     const Vec3 target = lightCenter + Vec3(rng.uniform() - 0.5f, 0.0f, rng.uniform() - 0.5f) * 0.5f;
     b.shadow.push_back(spawnRayTo(hit.p, hit.ng, hit.pError, target, Vec3(0.0f, -1.0f, 0.0f),
                                   roundingErrorBound(maxAbsComponent(target))));
     b.shadowDist.push_back(b.shadow.back().tMax);
+    b.shadowMask.push_back(hit.rayMask(target - hit.p) & lightMask);
   }
   return b;
 }

@@ -21,9 +21,11 @@ struct SurfaceHit {
   const Material* material = nullptr;
   const Light* light = nullptr;  // the area light this surface belongs to, if it emits
   Color emission{0.0f};          // radiance emitted on the side of ng
-  // The Embree ray mask of rays leaving the surface: every bit but its own shape's where that is
-  // flat (Shape::flat), since they cannot meet it again; every bit otherwise.
-  uint32_t rayMask = 0xFFFFFFFFu;
+  // The Embree ray masks of rays leaving the surface to the side of ng and to the other side:
+  // every bit but the surface's own shape's where such a ray cannot meet the shape again (either
+  // side of a flat shape, the outer side of a convex solid's boundary: Shape::flat,
+  // Shape::convexSide); every bit otherwise.
+  uint32_t maskFront = 0xFFFFFFFFu, maskBack = 0xFFFFFFFFu;
   bool twoSidedEmission = false;  // emits on both sides (glTF doubleSided)
 
   // Radiance the surface emits towards direction w: only on the side of ng unless two-sided.
@@ -32,6 +34,8 @@ struct SurfaceHit {
   }
   // Origin for a ray leaving the surface in direction dir: p pushed off it by its error bound.
   Vec3 offsetOrigin(const Vec3& dir) const { return offsetAlongNormal(p, ng, pError, dir); }
+  // The mask of a ray leaving towards `dir`, on the side offsetOrigin pushes it to.
+  uint32_t rayMask(const Vec3& dir) const { return glm::dot(dir, ng) >= 0.0f ? maskFront : maskBack; }
 };
 
 }  // namespace ember

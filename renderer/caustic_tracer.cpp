@@ -254,7 +254,7 @@ bool CausticTracer::connect(const Scene& scene, int maxDepth, PathState& path, c
       const float we =
           1.0f / (camera.imagePlaneArea() * cosCamera * cosCamera * cosCamera * dist2 * path.pathsPerPixel);
       splat.ray = spawnRayTo(hit.p, hit.ng, hit.pError, camera.origin(), Vec3(0.0f), 0.0f);
-      splat.mask = hit.rayMask;
+      splat.mask = hit.rayMask(camera.origin() - hit.p);
       splat.x = std::min(int(raster.x), camera.width() - 1);
       splat.y = std::min(int(raster.y), camera.height() - 1);
       splat.value = path.beta * f * we;
@@ -283,7 +283,7 @@ bool CausticTracer::follow(int rrDepth, PathState& path, const SurfaceHit& hit, 
     path.scattering /= q;
   }
   path.ray = Ray{hit.offsetOrigin(bs.wi), bs.wi};
-  path.rayMask = hit.rayMask;
+  path.rayMask = hit.rayMask(bs.wi);
   ++path.segments;
   return true;
 }

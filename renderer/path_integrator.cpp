@@ -42,7 +42,8 @@ bool PathIntegrator::shadowFor(const SurfaceHit& hit, const PathState& path, con
   const float lightPdf = pick.pmf * ls.pdf;
   const float weight = ls.delta || strategy_ == Strategy::Light ? 1.0f : powerHeuristic(lightPdf, bsdfPdf);
   shadow.contribution = path.throughput * (f * ls.Li * (weight / lightPdf));
-  shadow.mask = hit.rayMask & pick.light->shadowMask;
+  // The side the ray leaves to, as the origin's offset above took it.
+  shadow.mask = hit.rayMask(std::isfinite(ls.dist) ? ls.p - hit.p : ls.wi) & pick.light->shadowMask;
   ++stats.shadowRays;
   return true;
 }
@@ -142,7 +143,7 @@ bool PathIntegrator::followBsdfSample(PathState& path, const SurfaceHit& hit, co
   if (path.depth == 1) path.firstBounceNonDelta = !bs.delta;
   path.etaProduct *= bs.eta;
   path.ray = Ray{hit.offsetOrigin(bs.wi), bs.wi};
-  path.rayMask = hit.rayMask;
+  path.rayMask = hit.rayMask(bs.wi);
 
   if (path.depth >= rrDepth_) {
     const float q = std::min(maxComponent(path.throughput) * path.etaProduct * path.etaProduct, 0.95f);

@@ -51,14 +51,18 @@ void Scene::build() {
   std::vector<Light*> allLights;
   for (auto& light : lights) allLights.push_back(light.get());
 
-  // Embree has 32 mask bits: each goes to one flat shape (Shape::flat), emitters first (their
-  // shadow rays skip them too), and any flat shapes past the 32nd are tested as before.
+  // Embree has 32 mask bits: each goes to one flat shape or convex solid's boundary (Shape::flat,
+  // Shape::convexSide), flat emitters first (their shadow rays skip them too), and any such
+  // shapes past the 32nd are tested as before.
   std::vector<uint32_t> ownBits(shapes.size(), 0u);
   unsigned maskBits = 0;
-  for (const bool emitters : {true, false})
-    for (size_t i = 0; i < shapes.size(); ++i)
-      if (maskBits < 32 && !isBlack(shapes[i].emission) == emitters && shapes[i].shape->flat())
+  for (const bool flatEmitters : {true, false})
+    for (size_t i = 0; i < shapes.size(); ++i) {
+      const Shape& s = *shapes[i].shape;
+      const bool flatEmitter = s.flat() && !isBlack(shapes[i].emission);
+      if (maskBits < 32 && flatEmitter == flatEmitters && (s.flat() || s.convexSide() != 0))
         ownBits[i] = 1u << maskBits++;
+    }
   for (size_t i = 0; i < shapes.size(); ++i) {
     ShapeEntry& entry = shapes[i];
     // Analytic shapes have no surface maps and AreaLight's radiance is uniform, so the material
@@ -70,11 +74,16 @@ void Scene::build() {
     GeometryRecord rec{entry.shape.get(), nullptr,        entry.material,
                        nullptr,           entry.emission, entry.twoSidedEmission};
     rec.readsUv = readsUv;
-    rec.rayMask = ~ownBit;
+    const bool flat = entry.shape->flat();
+    const int convex = entry.shape->convexSide();
+    rec.maskFront = flat || convex > 0 ? ~ownBit : EmbreeAccel::kAllMask;
+    rec.maskBack = flat || convex < 0 ? ~ownBit : EmbreeAccel::kAllMask;
     if (emits) {
       lights.push_back(
           std::make_unique<AreaLight>(entry.shape.get(), entry.emission, entry.twoSidedEmission));
-      lights.back()->shadowMask = ~ownBit;
+      // Shadow rays skip flat emitters only: one aimed at a curved emitter's far side, sampled by
+      // area from close by, must still be blocked by its near side.
+      lights.back()->shadowMask = flat ? ~ownBit : EmbreeAccel::kAllMask;
       allLights.push_back(lights.back().get());
       rec.light = lights.back().get();
     }
@@ -185,7 +194,8 @@ void Scene::surfaceHit(const Ray& ray, const RawHit& raw, SurfaceHit& hit) const
       rec.firstTriangleLight >= 0 ? triangleLights_[size_t(rec.firstTriangleLight) + raw.primID] : rec.light;
   hit.emission = rec.emission;
   hit.twoSidedEmission = rec.twoSidedEmission;
-  hit.rayMask = rec.rayMask;
+  hit.maskFront = rec.maskFront;
+  hit.maskBack = rec.maskBack;
   if (rec.maps && rec.maps->emission && !isBlack(rec.emission))
     hit.emission *= rec.maps->emission->eval(hit.uv);
 }

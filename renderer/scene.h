@@ -122,7 +122,7 @@ class Scene {
     const SurfaceMaps* maps = nullptr;
     int64_t firstTriangleLight = -1;  // emissive meshes: index of primitive 0's light in triangleLights_
     bool readsUv = true;              // whether the material reads the hit's texture coordinates
-    uint32_t rayMask = 0xFFFFFFFFu;   // SurfaceHit::rayMask of its hits
+    uint32_t maskFront = 0xFFFFFFFFu, maskBack = 0xFFFFFFFFu;  // SurfaceHit's of its hits
   };
 
   std::vector<CausticCaster> findCausticCasters() const;
