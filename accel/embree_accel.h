@@ -51,8 +51,9 @@ class EmbreeAccel {
   EmbreeAccel(const EmbreeAccel&) = delete;
   EmbreeAccel& operator=(const EmbreeAccel&) = delete;
 
-  // Rays whose mask shares no bit with a geometry's skip it. Every ray and geometry has all bits
-  // set but shadow rays aimed at a flat emitter and that emitter (Shape::flat, Light::shadowMask).
+  // Rays whose mask shares no bit with a geometry's skip it. Geometries have all bits but the flat
+  // shapes and convex solids Scene gives one bit of their own; rays have all bits but those of
+  // the shapes they cannot meet (SurfaceHit::maskFront, Light::shadowMask).
   static constexpr uint32_t kAllMask = 0xFFFFFFFFu;
 
   // The pointers must outlive this object. `needsUv`: whether the shape's hits need texture

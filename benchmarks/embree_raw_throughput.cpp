@@ -40,21 +40,25 @@ RayBatch makeRays(const Scene& scene, size_t n) {
   RayBatch b;
   Rng rng(11, 1);
   const Vec3 lightCenter(0.0f, 1.98f, 0.0f);
-  uint32_t lightMask = EmbreeAccel::kAllMask;  // the scene's one light's Light::shadowMask
-  for (const auto& light : scene.lights) lightMask &= light->shadowMask;
+  // The light's Light::shadowMask; all bits unless the scene has exactly one light (the rays aim
+  // at cornell-area's).
+  const uint32_t lightMask = scene.lights.size() == 1 ? scene.lights[0]->shadowMask : EmbreeAccel::kAllMask;
   while (b.closest.size() < n) {
     const Ray cam = scene.camera().generateRay(rng.uniform() * 256.0f, rng.uniform() * 256.0f);
     SurfaceHit hit;
     if (!scene.intersect(cam, hit)) continue;
     const Vec3 n0 = glm::dot(hit.ng, cam.dir) < 0.0f ? hit.ng : -hit.ng;
     const Vec3 dir = Frame(n0).toWorld(sampleCosineHemisphere(Vec2(rng.uniform(), rng.uniform())));
-    b.closest.push_back(Ray{hit.offsetOrigin(dir), dir});
-    b.closestMask.push_back(hit.rayMask(dir));
+    const bool front = frontSide(hit.ng, dir);
+    b.closest.push_back(Ray{hit.offsetOrigin(front), dir});
+    b.closestMask.push_back(hit.maskFor(front));
     const Vec3 target = lightCenter + Vec3(rng.uniform() - 0.5f, 0.0f, rng.uniform() - 0.5f) * 0.5f;
-    b.shadow.push_back(spawnRayTo(hit.p, hit.ng, hit.pError, target, Vec3(0.0f, -1.0f, 0.0f),
-                                  roundingErrorBound(maxAbsComponent(target))));
+    const float targetError = roundingErrorBound(maxAbsComponent(target));
+    const bool toLight = frontSide(hit.ng, target - hit.p);
+    b.shadow.push_back(
+        spawnRayTo(hit.p, hit.ng, hit.pError, target, Vec3(0.0f, -1.0f, 0.0f), targetError, toLight));
     b.shadowDist.push_back(b.shadow.back().tMax);
-    b.shadowMask.push_back(hit.rayMask(target - hit.p) & lightMask);
+    b.shadowMask.push_back(hit.maskToward(target, targetError, toLight) & lightMask);
   }
   return b;
 }

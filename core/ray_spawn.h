@@ -19,8 +19,16 @@ inline float roundingErrorBound(float m) {
 // `p` pushed along the normal `n` by `error` to the side `dir` points to (Woo et al. 1996): large
 // enough to escape self-intersection, small enough not to cross a neighbouring face near an acute
 // edge (a cone's rim). A zero normal (a point light) leaves p where it is.
+// The side: whether `dir` leaves to the side n points to. Every caller that also needs the side
+// (SurfaceHit's ray masks) takes it from here, so that the two can never round differently.
+inline bool frontSide(const Vec3& n, const Vec3& dir) {
+  return glm::dot(dir, n) >= 0.0f;
+}
+inline Vec3 offsetAlongNormal(const Vec3& p, const Vec3& n, float error, bool front) {
+  return p + (front ? error : -error) * n;
+}
 inline Vec3 offsetAlongNormal(const Vec3& p, const Vec3& n, float error, const Vec3& dir) {
-  return p + (glm::dot(dir, n) >= 0.0f ? error : -error) * n;
+  return offsetAlongNormal(p, n, error, frontSide(n, dir));
 }
 
 // A ray along the segment between two points on surfaces, each given with its unit normal (zero
@@ -31,17 +39,22 @@ inline Vec3 offsetAlongNormal(const Vec3& p, const Vec3& n, float error, const V
 // rounded to float, which moves its end by a few ulps of the length). No shape needs a case of its
 // own: the segment ends in the open half-space in front of the target's tangent plane, which a
 // convex emitter never enters, and a flat one only at the far end's offset.
-// Returns a ray with tMax = 0 when the two points coincide.
+// Returns a ray with tMax = 0 when the two points coincide. `fromFront`: the side of nFrom to push
+// the origin to, frontSide(nFrom, to - from), given by a caller that needs it too.
 inline Ray spawnRayTo(const Vec3& from, const Vec3& nFrom, float errorFrom, const Vec3& to, const Vec3& nTo,
-                      float errorTo) {
+                      float errorTo, bool fromFront) {
   const Vec3 d = to - from;
-  const Vec3 origin = offsetAlongNormal(from, nFrom, errorFrom, d);
+  const Vec3 origin = offsetAlongNormal(from, nFrom, errorFrom, fromFront);
   const Vec3 target = offsetAlongNormal(to, nTo, errorTo, -d);
   const Vec3 segment = target - origin;
   const float length = glm::length(segment);
   if (!(length > 0.0f)) return Ray{origin, Vec3(0.0f, 0.0f, 1.0f), 0.0f};
   const float stopShort = errorTo + roundingErrorBound(length);
   return Ray{origin, segment / length, std::max(0.0f, length - stopShort)};
+}
+inline Ray spawnRayTo(const Vec3& from, const Vec3& nFrom, float errorFrom, const Vec3& to, const Vec3& nTo,
+                      float errorTo) {
+  return spawnRayTo(from, nFrom, errorFrom, to, nTo, errorTo, frontSide(nFrom, to - from));
 }
 
 }  // namespace ember

@@ -34,8 +34,19 @@ struct SurfaceHit {
   }
   // Origin for a ray leaving the surface in direction dir: p pushed off it by its error bound.
   Vec3 offsetOrigin(const Vec3& dir) const { return offsetAlongNormal(p, ng, pError, dir); }
-  // The mask of a ray leaving towards `dir`, on the side offsetOrigin pushes it to.
-  uint32_t rayMask(const Vec3& dir) const { return glm::dot(dir, ng) >= 0.0f ? maskFront : maskBack; }
+  // The same for a side already decided (frontSide(ng, dir)), and the Embree mask of a ray that
+  // leaves to it: callers decide the side once for both.
+  Vec3 offsetOrigin(bool front) const { return offsetAlongNormal(p, ng, pError, front); }
+  uint32_t maskFor(bool front) const { return front ? maskFront : maskBack; }
+  // The mask of a segment spawnRayTo made from p (origin pushed to side `front`) to `to`, a point
+  // within errorTo of the one it aims at: the surface's own bit is left out only where `to` lies
+  // clearly off the surface's tangent plane, so that the segment's far end is on the origin's
+  // side too (a light sampled on the very surface it lights is not).
+  uint32_t maskToward(const Vec3& to, float errorTo, bool front) const {
+    const Vec3 d = to - p;
+    const bool clear = std::abs(glm::dot(d, ng)) > pError + errorTo + roundingErrorBound(maxAbsComponent(d));
+    return clear ? maskFor(front) : 0xFFFFFFFFu;
+  }
 };
 
 }  // namespace ember

@@ -104,7 +104,7 @@ class ShadowBatch {
   void clear() { size_ = 0; }
   size_t size() const { return size_; }
   // Appends a ray blocked by anything on its open segment (0, ray.tMax) whose Embree mask shares
-  // a bit with `mask` (EmbreeAccel::kAllMask, or a light's shadowMask).
+  // a bit with `mask` (all bits, or the surface's and the light's: ShadowRequest::mask).
   void push(const Ray& ray, uint32_t mask = 0xFFFFFFFFu);
   void trace(const EmbreeAccel& accel, BatchTraversal traversal = BatchTraversal::Packets);
   bool occluded(size_t i) const {

@@ -253,8 +253,9 @@ bool CausticTracer::connect(const Scene& scene, int maxDepth, PathState& path, c
       // pixel of this sample index, each splat is beta f / (A cos^3 d^2 paths/pixel).
       const float we =
           1.0f / (camera.imagePlaneArea() * cosCamera * cosCamera * cosCamera * dist2 * path.pathsPerPixel);
-      splat.ray = spawnRayTo(hit.p, hit.ng, hit.pError, camera.origin(), Vec3(0.0f), 0.0f);
-      splat.mask = hit.rayMask(camera.origin() - hit.p);
+      const bool front = frontSide(hit.ng, camera.origin() - hit.p);
+      splat.ray = spawnRayTo(hit.p, hit.ng, hit.pError, camera.origin(), Vec3(0.0f), 0.0f, front);
+      splat.mask = hit.maskToward(camera.origin(), 0.0f, front);
       splat.x = std::min(int(raster.x), camera.width() - 1);
       splat.y = std::min(int(raster.y), camera.height() - 1);
       splat.value = path.beta * f * we;
@@ -282,8 +283,9 @@ bool CausticTracer::follow(int rrDepth, PathState& path, const SurfaceHit& hit, 
     path.beta /= q;
     path.scattering /= q;
   }
-  path.ray = Ray{hit.offsetOrigin(bs.wi), bs.wi};
-  path.rayMask = hit.rayMask(bs.wi);
+  const bool front = frontSide(hit.ng, bs.wi);
+  path.ray = Ray{hit.offsetOrigin(front), bs.wi};
+  path.rayMask = hit.maskFor(front);
   ++path.segments;
   return true;
 }

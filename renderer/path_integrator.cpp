@@ -31,8 +31,10 @@ bool PathIntegrator::shadowFor(const SurfaceHit& hit, const PathState& path, con
   if (isBlack(f)) return false;
 
   // Lights at a finite distance: a segment between the two points that neither surface blocks.
-  const Ray ray = std::isfinite(ls.dist) ? spawnRayTo(hit.p, hit.ng, hit.pError, ls.p, ls.n, ls.pError)
-                                         : Ray{hit.offsetOrigin(ls.wi), ls.wi, kInfinity};
+  const bool finite = std::isfinite(ls.dist);
+  const bool front = frontSide(hit.ng, finite ? ls.p - hit.p : ls.wi);
+  const Ray ray = finite ? spawnRayTo(hit.p, hit.ng, hit.pError, ls.p, ls.n, ls.pError, front)
+                         : Ray{hit.offsetOrigin(front), ls.wi, kInfinity};
   // Field by field: copied whole, GCC built the Ray in a temporary with narrow stores and moved it
   // with wide loads, which waited on those stores (`perf annotate`: a quarter of this function).
   static_assert(sizeof(Ray) == 2 * sizeof(Vec3) + sizeof(float), "copy every field of Ray");
@@ -42,8 +44,8 @@ bool PathIntegrator::shadowFor(const SurfaceHit& hit, const PathState& path, con
   const float lightPdf = pick.pmf * ls.pdf;
   const float weight = ls.delta || strategy_ == Strategy::Light ? 1.0f : powerHeuristic(lightPdf, bsdfPdf);
   shadow.contribution = path.throughput * (f * ls.Li * (weight / lightPdf));
-  // The side the ray leaves to, as the origin's offset above took it.
-  shadow.mask = hit.rayMask(std::isfinite(ls.dist) ? ls.p - hit.p : ls.wi) & pick.light->shadowMask;
+  shadow.mask =
+      (finite ? hit.maskToward(ls.p, ls.pError, front) : hit.maskFor(front)) & pick.light->shadowMask;
   ++stats.shadowRays;
   return true;
 }
@@ -142,8 +144,9 @@ bool PathIntegrator::followBsdfSample(PathState& path, const SurfaceHit& hit, co
   path.previousPoint = hit.p;
   if (path.depth == 1) path.firstBounceNonDelta = !bs.delta;
   path.etaProduct *= bs.eta;
-  path.ray = Ray{hit.offsetOrigin(bs.wi), bs.wi};
-  path.rayMask = hit.rayMask(bs.wi);
+  const bool front = frontSide(hit.ng, bs.wi);
+  path.ray = Ray{hit.offsetOrigin(front), bs.wi};
+  path.rayMask = hit.maskFor(front);
 
   if (path.depth >= rrDepth_) {
     const float q = std::min(maxComponent(path.throughput) * path.etaProduct * path.etaProduct, 0.95f);

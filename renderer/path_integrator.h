@@ -50,7 +50,7 @@ struct PathState {
 struct ShadowRequest {
   Ray ray;
   Color contribution;
-  uint32_t mask;  // the surface's rayMask and the light's shadowMask
+  uint32_t mask = 0xFFFFFFFFu;  // its Embree mask: the surface's (SurfaceHit) and the light's shadowMask
 };
 
 // The light next-event estimation chose at a vertex, with the random numbers for its sample.

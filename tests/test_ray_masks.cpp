@@ -4,6 +4,9 @@
 // out, and Embree skips the shape for them. The skip must never change what a ray finds: a masked
 // ray hits exactly what an unmasked one hits, and a shadow ray is blocked exactly when it was
 // before.
+#include "accel/box.h"
+#include "accel/cone.h"
+#include "accel/cylinder.h"
 #include "accel/disc.h"
 #include "accel/flipped_shape.h"
 #include "accel/sphere.h"
@@ -15,6 +18,7 @@
 #include "renderer/scene.h"
 
 #include <gtest/gtest.h>
+#include <glm/gtc/matrix_transform.hpp>
 
 #include <bit>
 #include <cstring>
@@ -62,11 +66,14 @@ SurfaceHit hitOnLayer(const Scene& scene, int i, float x, float z) {
   return hit;
 }
 
-// The ray leaving `from` towards its direction finds, with from's mask, exactly what it finds
-// without: whether it hits, and where. Returns whether it hit.
-bool findsTheSameMasked(const Scene& scene, const SurfaceHit& from, const Ray& leaving) {
+// The ray leaving `from` towards `dir` finds, with its mask, exactly what it finds without:
+// whether it hits, and where. Returns whether it hit; `mask` is the mask it had.
+bool findsTheSameMasked(const Scene& scene, const SurfaceHit& from, const Vec3& dir, uint32_t& mask) {
+  const bool front = frontSide(from.ng, dir);
+  const Ray leaving{from.offsetOrigin(front), dir};
+  mask = from.maskFor(front);
   SurfaceHit masked, unmasked;
-  const bool hit = scene.intersect(leaving, masked, from.rayMask(leaving.dir));
+  const bool hit = scene.intersect(leaving, masked, mask);
   EXPECT_EQ(hit, scene.intersect(leaving, unmasked));
   if (hit) {
     EXPECT_EQ(std::memcmp(&masked.t, &unmasked.t, sizeof(float)), 0);
@@ -100,6 +107,17 @@ TEST(RayMasks, FlatShapesHaveBitsOfTheirOwnEmittersFirst) {
   EXPECT_EQ(onBall.maskBack, 0xFFFFFFFFu);
 }
 
+// A segment from a surface to a point within rounding of its own plane (a light sampled on the
+// surface it lights) keeps the surface's bit: its far end may lie on the other side.
+TEST(RayMasks, ASegmentAlongItsOwnPlaneKeepsTheSurfacesBit) {
+  const Scene scene = stackedQuads();
+  const SurfaceHit from = hitOnLayer(scene, 3, 0.1f, 0.2f);
+  const Vec3 onPlane(-0.5f, from.p.y, 0.4f);
+  EXPECT_EQ(from.maskToward(onPlane, from.pError, frontSide(from.ng, onPlane - from.p)), 0xFFFFFFFFu);
+  const Vec3 above(-0.5f, from.p.y + 0.05f, 0.4f);
+  EXPECT_NE(from.maskToward(above, 0.0f, frontSide(from.ng, above - from.p)), 0xFFFFFFFFu);
+}
+
 // What makes the equality below meaningful: Embree does skip a shape for a ray whose mask leaves
 // out its bit (Debian's Embree is built with ray masks).
 TEST(RayMasks, ARaySkipsTheShapeItsMaskLeavesOut) {
@@ -114,9 +132,10 @@ TEST(RayMasks, ARaySkipsTheShapeItsMaskLeavesOut) {
   EXPECT_FALSE(scene.occluded(toLight, areaLight(scene).shadowMask));
 }
 
-// Balls in a closed box of spheres and flipped spheres: rays leave the balls outwards (masked)
-// and, through the flipped ones' insides, inwards (not masked), and the outer sphere from inside.
-TEST(RayMasks, RaysLeavingConvexSolidsFindWhatUnmaskedRaysFind) {
+// Balls, flipped balls, a box, open and capped cylinders and cones, a disc and a triangle inside a
+// flipped sphere: rays leave them to either side (masked where they cannot come back), and so do
+// segments to points in the room.
+TEST(RayMasks, RaysLeavingSolidsAndPlanesFindWhatUnmaskedRaysFind) {
   Scene scene;
   const Material* grey =
       scene.addMaterial("grey", std::make_unique<Lambertian>(std::make_shared<ConstantTexture>(Color(0.5f))));
@@ -130,6 +149,26 @@ TEST(RayMasks, RaysLeavingConvexSolidsFindWhatUnmaskedRaysFind) {
     if (i % 3 == 0) ball = std::make_unique<FlippedShape>(std::move(ball));
     scene.shapes.push_back({"ball", std::move(ball), grey, Color(0.0f)});
   }
+  // The other convex solids, open tubes and cones among them (seen from inside through their
+  // open ends), and flat shapes in the room.
+  const glm::mat3 turn = glm::mat3(glm::rotate(glm::mat4(1.0f), 0.7f, glm::normalize(Vec3(1, 2, 3))));
+  scene.shapes.push_back(
+      {"box", std::make_unique<Box>(Vec3(3, -3, 2), Vec3(2.0f, 1.0f, 1.5f), turn), grey, Color(0.0f)});
+  scene.shapes.push_back(
+      {"tube", std::make_unique<Cylinder>(Vec3(-4, 0, 0), Vec3(-1, 2, 1), 1.2f, false), grey, Color(0.0f)});
+  scene.shapes.push_back(
+      {"can", std::make_unique<Cylinder>(Vec3(2, 3, -3), Vec3(3, 5, -2), 0.8f, true), grey, Color(0.0f)});
+  scene.shapes.push_back(
+      {"funnel", std::make_unique<Cone>(Vec3(0, -4, 3), Vec3(1, -1, 2), 1.5f, false), grey, Color(0.0f)});
+  scene.shapes.push_back(
+      {"cone", std::make_unique<Cone>(Vec3(-3, -3, -3), Vec3(-2, -1, -4), 1.0f, true), grey, Color(0.0f)});
+  scene.shapes.push_back(
+      {"disc", std::make_unique<Disc>(Vec3(0, 5, 0), Vec3(0, -1, 0), 2.0f), grey, Color(0.0f)});
+  scene.shapes.push_back(
+      {"tri",
+       std::make_unique<Triangle>(std::array<Vec3, 3>{Vec3(-5, -5, 5), Vec3(5, -5, 5), Vec3(0, 5, 5)},
+                                  std::array<Vec2, 3>{Vec2(0, 0), Vec2(1, 0), Vec2(0, 1)}),
+       grey, Color(0.0f)});
   scene.build();
   Rng rng(9, 2);
   int compared = 0, masked = 0;
@@ -140,9 +179,15 @@ TEST(RayMasks, RaysLeavingConvexSolidsFindWhatUnmaskedRaysFind) {
     if (!scene.intersect(Ray{o, d}, from)) continue;
     const Vec3 dir = sampleUniformSphere(Vec2(rng.uniform(), rng.uniform()));  // either side
     SCOPED_TRACE(k);
-    findsTheSameMasked(scene, from, Ray{from.offsetOrigin(dir), dir});
+    uint32_t mask;
+    findsTheSameMasked(scene, from, dir, mask);
     ++compared;
-    masked += from.rayMask(dir) != 0xFFFFFFFFu;
+    masked += mask != 0xFFFFFFFFu;
+    // And a segment to a point in the room, as a shadow ray is made.
+    const Vec3 to(rng.uniform() * 16.0f - 8.0f, rng.uniform() * 16.0f - 8.0f, rng.uniform() * 16.0f - 8.0f);
+    const bool front = frontSide(from.ng, to - from.p);
+    const Ray segment = spawnRayTo(from.p, from.ng, from.pError, to, Vec3(0.0f), 0.0f, front);
+    EXPECT_EQ(scene.occluded(segment, from.maskToward(to, 0.0f, front)), scene.occluded(segment));
   }
   EXPECT_GT(compared, 3000);
   EXPECT_GT(masked, 1000);
@@ -182,12 +227,15 @@ TEST(RayMasks, MaskedRaysFindWhatUnmaskedRaysFind) {
     const Vec3 up = from.ng.y > 0.0f ? from.ng : -from.ng;
     const Vec3 dir = Frame(up).toWorld(sampleCosineHemisphere(Vec2(rng.uniform(), rng.uniform())));
     SCOPED_TRACE(k);
-    hitsCompared += findsTheSameMasked(scene, from, Ray{from.offsetOrigin(dir), dir});
+    uint32_t mask;
+    hitsCompared += findsTheSameMasked(scene, from, dir, mask);
     // A shadow ray to a point of the light.
     const Vec3 target(rng.uniform() - 0.5f, kLightY, rng.uniform() - 0.5f);
-    const Ray shadow = spawnRayTo(from.p, from.ng, from.pError, target, Vec3(0, -1, 0),
-                                  roundingErrorBound(maxAbsComponent(target)));
-    const bool occluded = scene.occluded(shadow, from.rayMask(target - from.p) & light.shadowMask);
+    const float targetError = roundingErrorBound(maxAbsComponent(target));
+    const bool front = frontSide(from.ng, target - from.p);
+    const Ray shadow = spawnRayTo(from.p, from.ng, from.pError, target, Vec3(0, -1, 0), targetError, front);
+    const bool occluded =
+        scene.occluded(shadow, from.maskToward(target, targetError, front) & light.shadowMask);
     EXPECT_EQ(occluded, scene.occluded(shadow)) << k;
     blocked += occluded;
     ++shadowsCompared;
