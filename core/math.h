@@ -5,7 +5,9 @@
 #include <glm/glm.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 
 namespace ember {
@@ -27,8 +29,14 @@ inline float maxComponent(const Vec3& v) {
 inline Vec3 absolute(const Vec3& v) {
   return {std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)};
 }
+// On the bit patterns: those of non-negative floats order as their values, and an integer max is a
+// conditional move, where GCC's profile-guided build turns std::max of floats into branches that
+// mispredict on hit points (1.5% of a render for one more call per shadow ray, seventeenth
+// session). Equal to maxComponent(absolute(v)) but for NaN components, which it propagates.
 inline float maxAbsComponent(const Vec3& v) {
-  return maxComponent(absolute(v));
+  const uint32_t x = std::bit_cast<uint32_t>(std::fabs(v.x)), y = std::bit_cast<uint32_t>(std::fabs(v.y)),
+                 z = std::bit_cast<uint32_t>(std::fabs(v.z));
+  return std::bit_cast<float>(std::max(x, std::max(y, z)));
 }
 inline bool isBlack(const Color& c) {
   return c.x == 0.0f && c.y == 0.0f && c.z == 0.0f;

@@ -43,8 +43,12 @@ struct SurfaceHit {
   // clearly off the surface's tangent plane, so that the segment's far end is on the origin's
   // side too (a light sampled on the very surface it lights is not).
   uint32_t maskToward(const Vec3& to, float errorTo, bool front) const {
+    // The dot product's own rounding is within a few ulps of sum |d_i| (|ng_i| <= 1); a sum rather
+    // than maxAbsComponent, whose std::max GCC's profile-guided build turns into branches that the
+    // data-dependent comparison mispredicts.
     const Vec3 d = to - p;
-    const bool clear = std::abs(glm::dot(d, ng)) > pError + errorTo + roundingErrorBound(maxAbsComponent(d));
+    const float sum = std::fabs(d.x) + std::fabs(d.y) + std::fabs(d.z);
+    const bool clear = std::fabs(glm::dot(d, ng)) > pError + errorTo + roundingErrorBound(sum);
     return clear ? maskFor(front) : 0xFFFFFFFFu;
   }
 };
