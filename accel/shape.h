@@ -82,7 +82,7 @@ class Shape {
   // Whether the whole shape lies in one plane. A ray leaving such a shape (its origin pushed off
   // the plane to the side it travels to, core/ray_spawn.h) never meets it again, and neither does a
   // shadow ray aimed at one of its points (stopped short of the plane): Scene gives flat shapes an
-  // Embree mask bit of their own, which those rays leave out (SurfaceHit::rayMask,
+  // Embree mask bit of their own, which those rays leave out (SurfaceHit::maskFor,
   // Light::shadowMask), so Embree skips their test.
   virtual bool flat() const { return false; }
   // +1 when the shape lies on the boundary of a convex solid and its normals point out of it

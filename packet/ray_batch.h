@@ -68,7 +68,7 @@ class ClosestHitBatch {
   size_t size() const { return size_; }
   size_t capacity() const { return storage_.capacity(); }
   // Appends a ray (tnear 0, tfar ray.tMax); its index is the size before the call.
-  // `mask`: the ray's Embree mask (all bits, or the SurfaceHit::rayMask of the surface it leaves).
+  // `mask`: the ray's Embree mask (all bits, or SurfaceHit::maskFor of the surface it leaves).
   void push(const Ray& ray, uint32_t mask = 0xFFFFFFFFu);
   void trace(const EmbreeAccel& accel, BatchTraversal traversal = BatchTraversal::Packets);
   // The closest hit of ray i, as EmbreeAccel::intersect reports it; false if it hit nothing.

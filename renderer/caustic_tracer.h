@@ -106,7 +106,7 @@ class CausticTracer {
     int segments = 1;        // light segments cast so far, counting the one in flight
     int index = 0;           // the splat image (sample index within the pass)
     float pathsPerPixel = 1.0f;
-    uint32_t rayMask = 0xFFFFFFFFu;  // the Embree mask of `ray` (SurfaceHit::rayMask, Light::shadowMask)
+    uint32_t rayMask = 0xFFFFFFFFu;  // the Embree mask of `ray` (SurfaceHit::maskFor, Light::shadowMask)
   };
   // A connection to the camera: `value` goes to pixel (x, y) if `ray` is unblocked.
   struct Splat {

@@ -39,7 +39,7 @@ struct PathState {
   bool previousDelta = true;  // camera rays count as specular: emitters they see get weight 1
   float previousPdf = 0.0f;
   Vec3 previousPoint{0.0f};
-  // The Embree mask of `ray`: the SurfaceHit::rayMask of the surface it leaves.
+  // The Embree mask of `ray`: SurfaceHit::maskFor of the surface it leaves, on its side.
   uint32_t rayMask = 0xFFFFFFFFu;
   int depth = 1;                     // segments cast so far, counting the one in flight
   bool firstBounceNonDelta = false;  // the camera vertex scattered through a non-Dirac lobe

@@ -77,7 +77,7 @@ class Scene {
   void build();
   bool built() const { return accel_ != nullptr; }
 
-  // `mask`: the Embree ray mask (all bits, or the SurfaceHit::rayMask of the surface it leaves).
+  // `mask`: the Embree ray mask (all bits, or SurfaceHit::maskFor of the surface it leaves).
   bool intersect(const Ray& ray, SurfaceHit& hit, uint32_t mask = 0xFFFFFFFFu) const;
   // The full record of a hit the accelerator found for `ray` (alone or in a batch).
   void surfaceHit(const Ray& ray, const RawHit& raw, SurfaceHit& hit) const;

@@ -1,9 +1,8 @@
 // Embree ray masks for flat shapes and convex solids' boundaries (Shape::flat, Shape::convexSide,
 // Scene::build): each gets a mask bit of its own, rays leaving it where they cannot meet it again
-// (SurfaceHit::rayMask) and shadow rays aimed at a flat emitter (Light::shadowMask) leave that bit
-// out, and Embree skips the shape for them. The skip must never change what a ray finds: a masked
-// ray hits exactly what an unmasked one hits, and a shadow ray is blocked exactly when it was
-// before.
+// (SurfaceHit::maskFor, maskToward) and shadow rays aimed at a flat emitter (Light::shadowMask) leave that
+// bit out, and Embree skips the shape for them. The skip must never change what a ray finds: a masked ray
+// hits exactly what an unmasked one hits, and a shadow ray is blocked exactly when it was before.
 #include "accel/box.h"
 #include "accel/cone.h"
 #include "accel/cylinder.h"
