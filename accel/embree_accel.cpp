@@ -73,7 +73,7 @@ static void meshOpacityFilter(const RTCFilterFunctionNArguments* args) {
 
 uint32_t EmbreeAccel::addMesh(const TriangleMesh* mesh) {
   RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-  rtcSetGeometryMask(geom, kAllMask);  // every ray tests meshes (Embree 3's default, stated)
+  rtcSetGeometryMask(geom, kAllRayMask);  // every ray tests meshes (Embree 3's default, stated)
   // Embree-owned buffers: Embree pads them as its SIMD loads need (16 bytes past the end).
   auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
       geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh->positions.size()));
@@ -99,7 +99,7 @@ void EmbreeAccel::commit() {
     throw std::runtime_error("Embree failed to build the scene (error " + std::to_string(int(err)) + ")");
 }
 
-static RTCRay toRtc(const Ray& ray, float tMin, uint32_t mask = EmbreeAccel::kAllMask) {
+static RTCRay toRtc(const Ray& ray, float tMin, uint32_t mask = kAllRayMask) {
   RTCRay r;
   r.org_x = ray.origin.x;
   r.org_y = ray.origin.y;

@@ -51,20 +51,18 @@ class EmbreeAccel {
   EmbreeAccel(const EmbreeAccel&) = delete;
   EmbreeAccel& operator=(const EmbreeAccel&) = delete;
 
-  // Rays whose mask shares no bit with a geometry's skip it. Geometries have all bits but the flat
-  // shapes and convex solids Scene gives one bit of their own; rays have all bits but those of
-  // the shapes they cannot meet (SurfaceHit::maskFront, Light::shadowMask).
-  static constexpr uint32_t kAllMask = 0xFFFFFFFFu;
-
+  // Rays whose mask shares no bit with a geometry's skip it (core/ray_spawn.h, kAllRayMask).
+  // Geometries have all bits but the flat shapes and convex solids Scene gives one bit of their
+  // own; rays have all bits but those of the shapes they cannot meet.
   // The pointers must outlive this object. `needsUv`: whether the shape's hits need texture
   // coordinates (accel/shape_lanes.h, RayLanes::needsUv).
-  uint32_t addShape(const Shape* shape, bool needsUv = true, uint32_t mask = kAllMask);
+  uint32_t addShape(const Shape* shape, bool needsUv = true, uint32_t mask = kAllRayMask);
   uint32_t addMesh(const TriangleMesh* mesh);
   void commit();
 
-  bool intersect(const Ray& ray, RawHit& hit, uint32_t mask = kAllMask) const;
+  bool intersect(const Ray& ray, RawHit& hit, uint32_t mask = kAllRayMask) const;
   // True when something blocks the open segment (tMin, tMax) of the ray.
-  bool occluded(const Ray& ray, float tMin = 0.0f, uint32_t mask = kAllMask) const;
+  bool occluded(const Ray& ray, float tMin = 0.0f, uint32_t mask = kAllRayMask) const;
 
   Bounds bounds() const;
   const char* isaName() const;

@@ -4,7 +4,7 @@
 // area light — as single rays (rtcIntersect1/rtcOccluded1) and as 8- and 16-wide packets, on 1 and
 // on all threads. The scene is Ember's own (analytic user geometry), so the numbers include the
 // cost of our intersection callbacks, exactly as Ember pays it, and the rays carry the Embree masks
-// Ember's own carry (Shape::flat).
+// Ember's own carry (Shape::flat, Shape::convexSide).
 //   embree_raw_throughput [scene.json] [--rays N] [--mix-only]
 // --mix-only measures the two vertex-mix rows alone (the limit), for benchmarks/limit_fraction.py.
 #include "core/sampling.h"
@@ -29,8 +29,8 @@ struct RayBatch {
   std::vector<Ray> closest;
   std::vector<Ray> shadow;
   std::vector<float> shadowDist;
-  // The Embree masks Ember's own rays carry (Shape::flat): a closest-hit ray skips the flat shape
-  // it leaves, a shadow ray that one and the light it is aimed at.
+  // The Embree masks Ember's own rays carry (Shape::flat, Shape::convexSide): a closest-hit ray
+  // skips the shape it leaves, a shadow ray that one and the flat light it is aimed at.
   std::vector<uint32_t> closestMask, shadowMask;
 };
 
@@ -42,7 +42,7 @@ RayBatch makeRays(const Scene& scene, size_t n) {
   const Vec3 lightCenter(0.0f, 1.98f, 0.0f);
   // The light's Light::shadowMask; all bits unless the scene has exactly one light (the rays aim
   // at cornell-area's).
-  const uint32_t lightMask = scene.lights.size() == 1 ? scene.lights[0]->shadowMask : EmbreeAccel::kAllMask;
+  const uint32_t lightMask = scene.lights.size() == 1 ? scene.lights[0]->shadowMask : kAllRayMask;
   while (b.closest.size() < n) {
     const Ray cam = scene.camera().generateRay(rng.uniform() * 256.0f, rng.uniform() * 256.0f);
     SurfaceHit hit;

@@ -8,6 +8,8 @@
 
 #include "core/math.h"
 
+#include <cstdint>
+
 namespace ember {
 
 // Bound on the float rounding error of a point computed from data whose magnitude is at most `m`:
@@ -19,6 +21,11 @@ inline float roundingErrorBound(float m) {
 // `p` pushed along the normal `n` by `error` to the side `dir` points to (Woo et al. 1996): large
 // enough to escape self-intersection, small enough not to cross a neighbouring face near an acute
 // edge (a cone's rim). A zero normal (a point light) leaves p where it is.
+// Every Embree mask bit: the mask of a ray that skips no geometry. Rays leaving a surface or aimed
+// at a light may leave out the bit of a shape they cannot meet (SurfaceHit::maskFor,
+// Light::shadowMask), and Embree then skips that shape.
+inline constexpr uint32_t kAllRayMask = 0xFFFFFFFFu;
+
 // The side: whether `dir` leaves to the side n points to. Every caller that also needs the side
 // (SurfaceHit's ray masks) takes it from here, so that the two can never round differently.
 inline bool frontSide(const Vec3& n, const Vec3& dir) {

@@ -25,7 +25,7 @@ struct SurfaceHit {
   // every bit but the surface's own shape's where such a ray cannot meet the shape again (either
   // side of a flat shape, the outer side of a convex solid's boundary: Shape::flat,
   // Shape::convexSide); every bit otherwise.
-  uint32_t maskFront = 0xFFFFFFFFu, maskBack = 0xFFFFFFFFu;
+  uint32_t maskFront = kAllRayMask, maskBack = kAllRayMask;
   bool twoSidedEmission = false;  // emits on both sides (glTF doubleSided)
 
   // Radiance the surface emits towards direction w: only on the side of ng unless two-sided.
@@ -49,7 +49,7 @@ struct SurfaceHit {
     const Vec3 d = to - p;
     const float sum = std::fabs(d.x) + std::fabs(d.y) + std::fabs(d.z);
     const bool clear = std::fabs(glm::dot(d, ng)) > pError + errorTo + roundingErrorBound(sum);
-    return clear ? maskFor(front) : 0xFFFFFFFFu;
+    return clear ? maskFor(front) : kAllRayMask;
   }
 };
 

@@ -47,7 +47,7 @@ void initFixedFields(RTCRayN* p, unsigned n) {
   for (unsigned lane = 0; lane < n; ++lane) {
     RTCRayN_time(p, n, lane) = 0.0f;
     // Debian's Embree is built with ray masks: 0 would miss everything.
-    RTCRayN_mask(p, n, lane) = 0xFFFFFFFFu;
+    RTCRayN_mask(p, n, lane) = kAllRayMask;
     RTCRayN_id(p, n, lane) = lane;
     RTCRayN_flags(p, n, lane) = 0;
   }

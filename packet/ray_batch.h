@@ -10,6 +10,7 @@
 #pragma once
 
 #include "accel/embree_accel.h"
+#include "core/ray_spawn.h"
 
 #include <embree3/rtcore.h>
 
@@ -69,7 +70,7 @@ class ClosestHitBatch {
   size_t capacity() const { return storage_.capacity(); }
   // Appends a ray (tnear 0, tfar ray.tMax); its index is the size before the call.
   // `mask`: the ray's Embree mask (all bits, or SurfaceHit::maskFor of the surface it leaves).
-  void push(const Ray& ray, uint32_t mask = 0xFFFFFFFFu);
+  void push(const Ray& ray, uint32_t mask = kAllRayMask);
   void trace(const EmbreeAccel& accel, BatchTraversal traversal = BatchTraversal::Packets);
   // The closest hit of ray i, as EmbreeAccel::intersect reports it; false if it hit nothing.
   bool hit(size_t i, RawHit& out) const;
@@ -105,7 +106,7 @@ class ShadowBatch {
   size_t size() const { return size_; }
   // Appends a ray blocked by anything on its open segment (0, ray.tMax) whose Embree mask shares
   // a bit with `mask` (all bits, or the surface's and the light's: ShadowRequest::mask).
-  void push(const Ray& ray, uint32_t mask = 0xFFFFFFFFu);
+  void push(const Ray& ray, uint32_t mask = kAllRayMask);
   void trace(const EmbreeAccel& accel, BatchTraversal traversal = BatchTraversal::Packets);
   bool occluded(size_t i) const {
     return RTCRayN_tfar(reinterpret_cast<RTCRayN*>(storage_.packetOf(i)), storage_.width(),

@@ -27,6 +27,7 @@
 
 #include "core/alias_table.h"
 #include "core/math.h"
+#include "core/ray_spawn.h"
 #include "renderer/camera.h"
 #include "renderer/sampler.h"
 
@@ -106,12 +107,12 @@ class CausticTracer {
     int segments = 1;        // light segments cast so far, counting the one in flight
     int index = 0;           // the splat image (sample index within the pass)
     float pathsPerPixel = 1.0f;
-    uint32_t rayMask = 0xFFFFFFFFu;  // the Embree mask of `ray` (SurfaceHit::maskFor, Light::shadowMask)
+    uint32_t rayMask = kAllRayMask;  // the Embree mask of `ray` (SurfaceHit::maskFor, Light::shadowMask)
   };
   // A connection to the camera: `value` goes to pixel (x, y) if `ray` is unblocked.
   struct Splat {
     Ray ray;
-    uint32_t mask = 0xFFFFFFFFu;  // the Embree mask of `ray`: the rayMask of the surface it leaves
+    uint32_t mask = kAllRayMask;  // the Embree mask of `ray` (SurfaceHit::maskToward)
     int x = 0, y = 0;
     Color value{0.0f};
   };

@@ -45,7 +45,7 @@ class Light {
   int samplerIndex = -1;  // position in the LightSampler's table
   // The Embree ray mask of shadow rays aimed at this light: all bits but its own geometry's where
   // that is a flat shape (Shape::flat), whose test they can skip; all bits otherwise.
-  uint32_t shadowMask = 0xFFFFFFFFu;
+  uint32_t shadowMask = kAllRayMask;
   // Its caustics come from the light tracer (renderer/caustic_tracer.h), which the path tracer
   // then leaves them to.
   bool causticTraced = false;

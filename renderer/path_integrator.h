@@ -23,6 +23,7 @@
 //           camera, or on an emitter the light sampler never picks.
 #pragma once
 
+#include "core/ray_spawn.h"
 #include "renderer/integrator.h"
 #include "renderer/strategy.h"
 
@@ -40,7 +41,7 @@ struct PathState {
   float previousPdf = 0.0f;
   Vec3 previousPoint{0.0f};
   // The Embree mask of `ray`: SurfaceHit::maskFor of the surface it leaves, on its side.
-  uint32_t rayMask = 0xFFFFFFFFu;
+  uint32_t rayMask = kAllRayMask;
   int depth = 1;                     // segments cast so far, counting the one in flight
   bool firstBounceNonDelta = false;  // the camera vertex scattered through a non-Dirac lobe
 };
@@ -50,7 +51,7 @@ struct PathState {
 struct ShadowRequest {
   Ray ray;
   Color contribution;
-  uint32_t mask = 0xFFFFFFFFu;  // its Embree mask: the surface's (SurfaceHit) and the light's shadowMask
+  uint32_t mask = kAllRayMask;  // its Embree mask: the surface's (SurfaceHit) and the light's shadowMask
 };
 
 // The light next-event estimation chose at a vertex, with the random numbers for its sample.

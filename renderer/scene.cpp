@@ -70,20 +70,20 @@ void Scene::build() {
     const bool readsUv = !entry.material || entry.material->readsUv();
     const bool emits = !isBlack(entry.emission);
     const uint32_t ownBit = ownBits[i];
-    const uint32_t id = accel_->addShape(entry.shape.get(), readsUv, ownBit ? ownBit : EmbreeAccel::kAllMask);
+    const uint32_t id = accel_->addShape(entry.shape.get(), readsUv, ownBit ? ownBit : kAllRayMask);
     GeometryRecord rec{entry.shape.get(), nullptr,        entry.material,
                        nullptr,           entry.emission, entry.twoSidedEmission};
     rec.readsUv = readsUv;
     const bool flat = entry.shape->flat();
     const int convex = entry.shape->convexSide();
-    rec.maskFront = flat || convex > 0 ? ~ownBit : EmbreeAccel::kAllMask;
-    rec.maskBack = flat || convex < 0 ? ~ownBit : EmbreeAccel::kAllMask;
+    rec.maskFront = flat || convex > 0 ? ~ownBit : kAllRayMask;
+    rec.maskBack = flat || convex < 0 ? ~ownBit : kAllRayMask;
     if (emits) {
       lights.push_back(
           std::make_unique<AreaLight>(entry.shape.get(), entry.emission, entry.twoSidedEmission));
       // Shadow rays skip flat emitters only: one aimed at a curved emitter's far side, sampled by
       // area from close by, must still be blocked by its near side.
-      lights.back()->shadowMask = flat ? ~ownBit : EmbreeAccel::kAllMask;
+      lights.back()->shadowMask = flat ? ~ownBit : kAllRayMask;
       allLights.push_back(lights.back().get());
       rec.light = lights.back().get();
     }

@@ -78,7 +78,7 @@ class Scene {
   bool built() const { return accel_ != nullptr; }
 
   // `mask`: the Embree ray mask (all bits, or SurfaceHit::maskFor of the surface it leaves).
-  bool intersect(const Ray& ray, SurfaceHit& hit, uint32_t mask = 0xFFFFFFFFu) const;
+  bool intersect(const Ray& ray, SurfaceHit& hit, uint32_t mask = kAllRayMask) const;
   // The full record of a hit the accelerator found for `ray` (alone or in a batch).
   void surfaceHit(const Ray& ray, const RawHit& raw, SurfaceHit& hit) const;
   // Geometries in the acceleration structure: every geomID is below this.
@@ -96,8 +96,8 @@ class Scene {
   void prefetchTriangle(uint32_t geomID, uint32_t primID) const;
   void prefetchVertices(uint32_t geomID, uint32_t primID) const;
   // True when something blocks the ray before ray.tMax (a shadow ray from core/ray_spawn.h).
-  // `mask`: the Embree ray mask (all bits, or a surface's rayMask and a light's shadowMask).
-  bool occluded(const Ray& ray, uint32_t mask = 0xFFFFFFFFu) const;
+  // `mask`: the Embree ray mask (all bits, or a surface's SurfaceHit::maskToward and a light's shadowMask).
+  bool occluded(const Ray& ray, uint32_t mask = kAllRayMask) const;
 
   const Camera& camera() const { return camera_; }
   const LightSampler& lightSampler() const { return lightSampler_; }
@@ -122,7 +122,7 @@ class Scene {
     const SurfaceMaps* maps = nullptr;
     int64_t firstTriangleLight = -1;  // emissive meshes: index of primitive 0's light in triangleLights_
     bool readsUv = true;              // whether the material reads the hit's texture coordinates
-    uint32_t maskFront = 0xFFFFFFFFu, maskBack = 0xFFFFFFFFu;  // SurfaceHit's of its hits
+    uint32_t maskFront = kAllRayMask, maskBack = kAllRayMask;  // SurfaceHit's of its hits
   };
 
   std::vector<CausticCaster> findCausticCasters() const;
