@@ -11,12 +11,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
+#include <string_view>
 
 namespace ember {
 
@@ -32,6 +34,7 @@ class GltfImporter {
 
   GltfImport run() {
     load();
+    checkVersion(model_.asset.version, model_.asset.minVersion);
     checkExtensions();
     result_.cameraCount = model_.cameras.size();
     if (options_.camera >= 0 && size_t(options_.camera) >= model_.cameras.size())
@@ -98,9 +101,27 @@ class GltfImporter {
     const bool ok = ext == ".glb" ? loader.LoadBinaryFromFile(&model_, &err, &warn, path_)
                                   : loader.LoadASCIIFromFile(&model_, &err, &warn, path_);
     if (!ok) {
-      // tinygltf trips over the data of extensions it cannot decode (Draco's missing bufferViews)
-      // before we see the file's extensionsRequired: name the extension rather than its symptom.
-      for (const std::string& ext : requiredExtensions())
+      // tinygltf trips over glTF 1.0's schema and over the data of extensions it cannot decode
+      // (Draco's missing bufferViews) before we see the file's version and extensionsRequired:
+      // name the cause rather than its symptom.
+      const nlohmann::json doc = fileJson();
+      if (doc.is_object() && doc.contains("asset") && doc["asset"].is_object()) {
+        const nlohmann::json& asset = doc["asset"];
+        const auto text = [&](const char* key) {
+          return asset.contains(key) && asset[key].is_string() ? asset[key].get<std::string>()
+                                                               : std::string();
+        };
+        checkVersion(text("version"), text("minVersion"));
+      }
+      // glTF 1.0 kept its objects in dictionaries keyed by id, where 2.0 has arrays; a 1.0 file
+      // without its asset object is still recognisable by them.
+      if (doc.is_object())
+        for (const char* key : {"accessors", "buffers", "meshes", "nodes"})
+          if (doc.contains(key) && doc[key].is_object())
+            fail(key,
+                 "an object keyed by id, as in glTF 1.0; Ember reads glTF 2.0 (convert the file, e.g. "
+                 "with the Khronos glTF-Pipeline or Blender's glTF 2.0 exporter)");
+      for (const std::string& ext : requiredExtensions(doc))
         if (!supportedExtensions().count(ext))
           fail("extensionsRequired", "the file requires " + ext + ", which Ember does not support");
       while (!err.empty() && (err.back() == '\n' || err.back() == '\r')) err.pop_back();
@@ -117,9 +138,9 @@ class GltfImporter {
     return supported;
   }
 
-  // extensionsRequired read straight from the file's JSON (.gltf, or a .glb's JSON chunk); empty
-  // when it cannot be read.
-  std::vector<std::string> requiredExtensions() const {
+  // The file's JSON read straight from it (.gltf, or a .glb's JSON chunk, which starts at byte 20
+  // in binary glTF 1.0 and 2.0 alike); a discarded value when it cannot be read.
+  nlohmann::json fileJson() const {
     std::ifstream in(path_, std::ios::binary);
     std::string bytes((std::istreambuf_iterator<char>(in)), {});
     if (bytes.size() >= 20 && bytes.compare(0, 4, "glTF") == 0) {
@@ -127,8 +148,49 @@ class GltfImporter {
       std::memcpy(&length, bytes.data() + 12, 4);
       bytes = bytes.substr(20, std::min<size_t>(length, bytes.size() - 20));
     }
+    return nlohmann::json::parse(bytes, nullptr, /*allow_exceptions=*/false);
+  }
+
+  // glTF 1.0 files (collada2gltf and other early exporters) follow another schema, which tinygltf
+  // reads as an empty 2.0 model or refuses with a message about its symptoms: name the version.
+  // As the 2.0 specification asks of loaders (section 3.2, "Asset"), a file whose major version
+  // is not 2, or whose minVersion is newer than 2.0, is refused. An absent version is left to
+  // tinygltf, which requires the asset object.
+  void checkVersion(const std::string& version, const std::string& minVersion) const {
+    // <major>.<minor> as the schema writes it; a bare <major> is taken as <major>.0.
+    const auto parse = [](const std::string& text, int& major, int& minor) {
+      const auto digits = [](std::string_view v) {
+        return !v.empty() && v.size() <= 6 &&
+               std::all_of(v.begin(), v.end(), [](char c) { return c >= '0' && c <= '9'; });
+      };
+      const size_t dot = std::min(text.find('.'), text.size());
+      const std::string_view a(text.data(), dot);
+      const std::string_view b = dot < text.size() ? std::string_view(text).substr(dot + 1) : "0";
+      if (!digits(a) || !digits(b)) return false;
+      major = std::stoi(std::string(a));
+      minor = std::stoi(std::string(b));
+      return true;
+    };
+    int major = 0, minor = 0;
+    if (!version.empty()) {
+      if (!parse(version, major, minor))
+        fail("asset.version", "'" + version + "' is not a glTF version of the form <major>.<minor>");
+      if (major != 2)
+        fail("asset.version", "the file is glTF " + version +
+                                  "; Ember reads glTF 2.0 (convert it, e.g. with " +
+                                  "the Khronos glTF-Pipeline or Blender's glTF 2.0 exporter)");
+    }
+    if (!minVersion.empty()) {
+      if (!parse(minVersion, major, minor))
+        fail("asset.minVersion", "'" + minVersion + "' is not a glTF version of the form <major>.<minor>");
+      if (major != 2 || minor > 0)
+        fail("asset.minVersion", "the file needs a glTF " + minVersion + " reader; Ember reads glTF 2.0");
+    }
+  }
+
+  // extensionsRequired of the file's JSON (fileJson); empty when it cannot be read.
+  static std::vector<std::string> requiredExtensions(const nlohmann::json& doc) {
     std::vector<std::string> out;
-    const nlohmann::json doc = nlohmann::json::parse(bytes, nullptr, /*allow_exceptions=*/false);
     if (doc.is_object() && doc.contains("extensionsRequired") && doc["extensionsRequired"].is_array())
       for (const auto& e : doc["extensionsRequired"])
         if (e.is_string()) out.push_back(e.get<std::string>());

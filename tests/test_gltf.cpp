@@ -3,6 +3,7 @@
 // truncated GLB, a missing .bin and a missing file fail cleanly: an InputError naming the file and
 // the problem, a non-zero exit code from the command line, and no output file.
 #include "cli_runner.h"
+#include "gltf_builder.h"
 #include "io/gltf_loader.h"
 #include "io/input_error.h"
 #include "io/scene_loader.h"
@@ -174,6 +175,51 @@ TEST(Gltf, BrokenAssimpFilesFailCleanly) {
     }
     expectCleanFailure(f);
   }
+}
+
+// glTF 1.0 (dictionaries keyed by id, another material model) is not read as an empty 2.0 file:
+// the error names the version, with or without the file's asset object, and so does a file that
+// needs a reader newer than 2.0. A 2.0 file declaring minVersion 2.0 loads.
+TEST(Gltf, OtherGltfVersionsAreRefusedByName) {
+  TempDir files;
+  const auto write = [&](const std::string& name, const std::string& json) {
+    std::ofstream(files.file(name)) << json;
+    return files.file(name);
+  };
+  const std::string v1 = R"({"asset": {"version": "1.0"}, "scene": "s", "scenes": {"s": {"nodes": []}}})";
+  expectCleanFailure({write("v1.gltf", v1), "asset.version: the file is glTF 1.0; Ember reads glTF 2.0"});
+  expectCleanFailure({write("v1-no-asset.gltf", R"({"accessors": {"a": {"count": 3}}, "meshes": {}})"),
+                      "accessors: an object keyed by id, as in glTF 1.0"});
+  expectCleanFailure({write("v3.gltf", R"({"asset": {"version": "3.0"}, "meshes": []})"),
+                      "asset.version: the file is glTF 3.0"});
+  expectCleanFailure({write("min.gltf", R"({"asset": {"version": "2.1", "minVersion": "2.1"}})"),
+                      "asset.minVersion: the file needs a glTF 2.1 reader"});
+  expectCleanFailure(
+      {write("bad.gltf", R"({"asset": {"version": "two"}})"), "asset.version: 'two' is not a glTF version"});
+
+  test::GltfBuilder b;
+  tinygltf::Material m;
+  m.pbrMetallicRoughness.baseColorFactor = {0.5, 0.5, 0.5, 1.0};
+  b.addQuad(1.0f, b.addMaterial(m));
+  b.model().asset.minVersion = "2.0";
+  ASSERT_TRUE(b.write(files.file("min20.gltf")));
+  Scene scene;
+  importGltf(files.file("min20.gltf"), scene);
+  EXPECT_EQ(scene.meshes.size(), 1u);
+}
+
+// The glTF 1.0 files of assimp-testmodels (models/glTF): each is refused as glTF 1.0.
+TEST(Gltf, AssimpGltf1FilesAreRefusedAsGltf1) {
+  const fs::path root = fs::path(test::assimpGltfDir()).parent_path() / "glTF";
+  if (!fs::is_directory(root)) GTEST_SKIP() << root << " not found (Debian package assimp-testmodels)";
+  int refused = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(root)) {
+    const std::string ext = entry.path().extension().string();
+    if (ext != ".gltf" && ext != ".glb") continue;
+    expectCleanFailure({entry.path().string(), "glTF 1.0"});
+    ++refused;
+  }
+  EXPECT_GE(refused, 6);  // Debian 12's assimp-testmodels 5.2.5 has 7
 }
 
 // Files of assimp-testmodels that are broken on purpose, or need an extension Ember cannot do
