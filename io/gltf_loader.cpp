@@ -35,6 +35,7 @@ class GltfImporter {
   GltfImport run() {
     load();
     checkVersion(model_.asset.version, model_.asset.minVersion);
+    checkPrimitiveArrays();
     checkExtensions();
     result_.cameraCount = model_.cameras.size();
     if (options_.camera >= 0 && size_t(options_.camera) >= model_.cameras.size())
@@ -185,6 +186,23 @@ class GltfImporter {
         fail("asset.minVersion", "'" + minVersion + "' is not a glTF version of the form <major>.<minor>");
       if (major != 2 || minor > 0)
         fail("asset.minVersion", "the file needs a glTF " + minVersion + " reader; Ember reads glTF 2.0");
+    }
+  }
+
+  // tinygltf reads a mesh whose `primitives` is not an array as a mesh without primitives, and the
+  // scene then silently lacks it: name the field instead. The JSON is read again only then.
+  void checkPrimitiveArrays() const {
+    nlohmann::json doc;
+    for (size_t i = 0; i < model_.meshes.size(); ++i) {
+      if (!model_.meshes[i].primitives.empty()) continue;
+      if (doc.is_null()) doc = fileJson();
+      if (!doc.is_object() || !doc.contains("meshes") || !doc["meshes"].is_array() ||
+          i >= doc["meshes"].size())
+        return;
+      const nlohmann::json& mesh = doc["meshes"][i];
+      if (mesh.is_object() && mesh.contains("primitives") && !mesh["primitives"].is_array())
+        fail("meshes[" + std::to_string(i) + "].primitives",
+             std::string("must be an array of primitives, not ") + mesh["primitives"].type_name());
     }
   }
 

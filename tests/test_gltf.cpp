@@ -163,6 +163,7 @@ TEST(Gltf, BrokenAssimpFilesFailCleanly) {
       {d + "BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb", "POSITION: contains NaN or infinite values"},
       {d + "SchemaFailures/sceneWrongType.gltf", "cannot load glTF"},
       {d + "TestNoRootNode/SceneWithoutNodes.gltf", "contains nothing to render"},
+      {d + "wrongTypes/badArray.gltf", "meshes[0].primitives: must be an array of primitives, not object"},
   };
   for (const BrokenFile& f : files) {
     if (f.expected == std::string("contains nothing to render")) {
