@@ -12,7 +12,9 @@ namespace ember {
 class Lambertian final : public Material {
  public:
   explicit Lambertian(std::shared_ptr<const Texture> reflectance)
-      : reflectance_(std::move(reflectance)), reflects_(!isBlack(reflectance_->maxValue())) {}
+      : reflectance_(std::move(reflectance)), reflects_(!isBlack(reflectance_->maxValue())) {
+    mayAbsorb_ = reflectance_->mayBeBlack();
+  }
 
   std::string_view typeName() const override { return "diffuse"; }
   Color eval(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const override;
@@ -27,6 +29,9 @@ class Lambertian final : public Material {
   bool readsUv() const override { return !reflectance_->isConstant(); }
 
  private:
+  bool absorbsEverythingAt(const SurfaceHit& hit) const override {
+    return isBlack(reflectance_->eval(hit.uv));
+  }
   // The sample from the kernel's direction and pdf.
   bool finishSample(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi, float pdf, BsdfSample& out) const;
 

@@ -52,10 +52,22 @@ class Material {
   // analytic shapes skip the UV (the sphere's inverse trigonometry) when the material reads none.
   virtual bool readsUv() const { return true; }
 
+  // Whether every lobe is black at this hit, so that the path ends here after its emission: its
+  // light sample and every continuation would carry exactly zero, and skipping them changes no
+  // pixel (Cycles likewise ends a path at a surface whose closures all have zero weight). A black
+  // texel of a diffuse texture is such a hit: on a black-and-white checkerboard 3% of the render
+  // (docs/performance.md). Only materials that can absorb somewhere check.
+  bool absorbsAt(const SurfaceHit& hit) const { return mayAbsorb_ && absorbsEverythingAt(hit); }
+
   // Fraction of radiance surviving `distance` through the medium this surface encloses (Beer-Lambert;
   // 1 for surfaces without an absorbing interior). Applied to path segments that reach the surface
   // from inside, i.e. against its outward geometric normal: correct for closed, non-nested objects.
   virtual Color interiorTransmittance(float /*distance*/) const { return Color(1.0f); }
+
+ protected:
+  // absorbsAt for a material that sets mayAbsorb_.
+  virtual bool absorbsEverythingAt(const SurfaceHit& /*hit*/) const { return false; }
+  bool mayAbsorb_ = false;  // some hit may be black in every lobe
 };
 
 // wo and wi on the same geometric side of the surface (a reflection, not a transmission).

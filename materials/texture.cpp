@@ -98,8 +98,12 @@ ImageTexture::ImageTexture(int width, int height, std::vector<Color> texels, Tex
       scale_(scale) {
   Color sum(0.0f);
   for (const Color& c : texels_) {
-    max_ = glm::max(max_, c * scale_);
-    sum += c * scale_;
+    const Color scaled = c * scale_;
+    max_ = glm::max(max_, scaled);
+    sum += scaled;
+    const bool positive = scaled.x > 0.0f || scaled.y > 0.0f || scaled.z > 0.0f;
+    const bool negative = scaled.x < 0.0f || scaled.y < 0.0f || scaled.z < 0.0f;
+    mayBeBlack_ = mayBeBlack_ || !positive || negative;
   }
   if (!texels_.empty()) average_ = sum / float(texels_.size());
 

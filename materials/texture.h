@@ -23,6 +23,8 @@ class Texture {
   virtual Color average() const = 0;
   // The same value at every uv.
   virtual bool isConstant() const { return false; }
+  // Whether eval can return black (every channel zero) at some uv; false only where it cannot.
+  virtual bool mayBeBlack() const { return true; }
 };
 
 class ConstantTexture final : public Texture {
@@ -32,6 +34,7 @@ class ConstantTexture final : public Texture {
   Color maxValue() const override { return value_; }
   Color average() const override { return value_; }
   bool isConstant() const override { return true; }
+  bool mayBeBlack() const override { return isBlack(value_); }
 
  private:
   Color value_;
@@ -51,6 +54,7 @@ class ImageTexture final : public Texture {
   Color eval(Vec2 uv) const override;
   Color maxValue() const override { return max_; }
   Color average() const override { return average_; }
+  bool mayBeBlack() const override { return mayBeBlack_; }
   int width() const { return width_; }
   int height() const { return height_; }
   // Whether the texels are kept as palette indices (see below).
@@ -77,6 +81,9 @@ class ImageTexture final : public Texture {
   TextureWrap wrapS_, wrapT_;
   Color scale_;
   Color max_{0.0f}, average_{0.0f};
+  // Some scaled texel is black or has a negative channel (whose bilinear blend with another texel
+  // could then be black): a blend of texels with neither always has a positive channel.
+  bool mayBeBlack_ = false;
 };
 
 // KHR_texture_transform: looks `inner` up at uv' = T R S uv (the extension's matrix: offset, then a
@@ -93,6 +100,7 @@ class UvTransformTexture final : public Texture {
   }
   Color maxValue() const override { return inner_->maxValue(); }
   Color average() const override { return inner_->average(); }
+  bool mayBeBlack() const override { return inner_->mayBeBlack(); }
 
  private:
   std::shared_ptr<const Texture> inner_;

@@ -122,7 +122,7 @@ bool PathIntegrator::arrive(const Scene& scene, PathState& path, const SurfaceHi
     }
   }
 
-  return !(maxDepth_ >= 0 && path.depth >= maxDepth_) && hit.material;
+  return !(maxDepth_ >= 0 && path.depth >= maxDepth_) && hit.material && !hit.material->absorbsAt(hit);
 }
 
 bool PathIntegrator::scatter(PathState& path, const SurfaceHit& hit, Sampler& sampler) const {

@@ -10,6 +10,7 @@
 #include "accel/triangle.h"
 #include "io/scene_loader.h"
 #include "materials/lambertian.h"
+#include "materials/texture.h"
 #include "renderer/path_integrator.h"
 #include "renderer/render.h"
 
@@ -155,6 +156,35 @@ TEST(Render, PlaneUnderPointLightMatchesAnalyticIrradiance) {
   const float expected = kAlbedo / kPi * kIntensity * cosTheta / r2;
   // The pixel footprint is ~1e-3 wide: the irradiance varies by far less than 1e-4 across it.
   EXPECT_NEAR(img.at(0, 0).x, expected, 1e-4f * expected);
+}
+
+// Paths end at a black texel after its emission (Material::absorbsAt), which must change nothing
+// but the time: the image equals the one whose dark texels are 1e-30 instead, and whose paths go
+// on from them with a throughput of 1e-30, up to those paths' 1e-30-sized contributions. Every
+// surface gets the checkerboard, the light's too, so that emission at black texels counts as well.
+TEST(Render, PathsEndingAtBlackTexelsLeaveTheImageAsItWas) {
+  const auto renderChecker = [](float dark) {
+    Scene scene = loadJsonScene(test::sourcePath("scenes/cornell-area.json"));
+    scene.settings.width = 32;
+    scene.settings.height = 24;
+    const std::vector<Color> texels = {Color(dark), Color(0.8f), Color(0.8f), Color(dark)};
+    auto texture = std::make_shared<ImageTexture>(2, 2, texels, TextureFilter::Nearest, TextureWrap::Repeat);
+    EXPECT_EQ(texture->mayBeBlack(), dark == 0.0f);
+    const Material* checker = scene.addMaterial("checker", std::make_unique<Lambertian>(std::move(texture)));
+    for (Scene::ShapeEntry& shape : scene.shapes) shape.material = checker;
+    scene.build();
+    return renderFilm(scene, 16, 3).mean();
+  };
+  const Image ended = renderChecker(0.0f), continued = renderChecker(1e-30f);
+  double sum = 0.0;
+  for (int y = 0; y < ended.height; ++y)
+    for (int x = 0; x < ended.width; ++x)
+      for (int c = 0; c < 3; ++c) {
+        const float a = ended.at(x, y)[c], b = continued.at(x, y)[c];
+        ASSERT_NEAR(a, b, 1e-6f * std::max(1.0f, b)) << "pixel (" << x << ", " << y << ") channel " << c;
+        sum += a;
+      }
+  EXPECT_GT(sum / (3.0 * ended.width * ended.height), 0.01);  // lit, not black everywhere
 }
 
 // Mean and standard error of the mean over all pixels of one channel.

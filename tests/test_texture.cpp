@@ -2,6 +2,9 @@
 // and everything else as floats; either way a lookup must return the texel's value bit for bit.
 #include "materials/texture.h"
 
+#include "core/surface_hit.h"
+#include "materials/lambertian.h"
+
 #include "core/rng.h"
 
 #include <gtest/gtest.h>
@@ -11,6 +14,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <vector>
 
 namespace ember {
@@ -63,6 +67,36 @@ TEST(Srgb, TableDecodeEqualsTheFormula) {
        {-0.0f, 1.0f / 255.0f + 1e-9f, 255.5f / 255.0f, std::numeric_limits<float>::infinity(),
         -std::numeric_limits<float>::infinity(), std::numeric_limits<float>::quiet_NaN(), 1e30f, -1e30f})
     EXPECT_TRUE(same(c)) << c;
+}
+
+// mayBeBlack is false only where no lookup can be black: a constant colour that is not black, or
+// an image none of whose scaled texels is black or has a negative channel (a bilinear blend of a
+// positive and a negative texel can be). Lambertian::absorbsAt then holds exactly at black texels.
+TEST(ImageTexture, MayBeBlackOnlyWithABlackOrNegativeTexel) {
+  EXPECT_FALSE(ConstantTexture(Color(0.5f, 0.0f, 0.0f)).mayBeBlack());
+  EXPECT_TRUE(ConstantTexture(Color(0.0f)).mayBeBlack());
+  const auto image = [](std::vector<Color> texels, Color scale = Color(1.0f)) {
+    return std::make_shared<ImageTexture>(2, 1, std::move(texels), TextureFilter::Bilinear,
+                                          TextureWrap::Repeat, scale);
+  };
+  EXPECT_FALSE(image({Color(0.1f, 0.1f, 0.3f), Color(0.9f)})->mayBeBlack());  // the shared checker's colours
+  EXPECT_FALSE(image({Color(0.0f, 0.0f, 0.2f), Color(0.3f, 0.0f, 0.0f)})->mayBeBlack());
+  EXPECT_TRUE(image({Color(0.0f), Color(0.9f)})->mayBeBlack());
+  EXPECT_TRUE(image({Color(0.5f, -0.5f, 0.0f), Color(-0.5f, 0.5f, 0.0f)})->mayBeBlack());
+  EXPECT_TRUE(
+      image({Color(0.0f, 0.5f, 0.0f), Color(0.9f)}, Color(1.0f, 0.0f, 1.0f))->mayBeBlack());  // scaled
+  EXPECT_TRUE(
+      UvTransformTexture(image({Color(0.0f), Color(0.9f)}), Vec2(0.0f), 0.0f, Vec2(1.0f)).mayBeBlack());
+
+  const Lambertian checker(std::make_shared<ImageTexture>(2, 1, std::vector<Color>{Color(0.0f), Color(0.9f)},
+                                                          TextureFilter::Nearest, TextureWrap::Repeat));
+  SurfaceHit hit;
+  hit.uv = Vec2(0.25f, 0.5f);
+  EXPECT_TRUE(checker.absorbsAt(hit));
+  hit.uv = Vec2(0.75f, 0.5f);
+  EXPECT_FALSE(checker.absorbsAt(hit));
+  EXPECT_TRUE(Lambertian(std::make_shared<ConstantTexture>(Color(0.0f))).absorbsAt(hit));
+  EXPECT_FALSE(Lambertian(std::make_shared<ConstantTexture>(Color(0.2f))).absorbsAt(hit));
 }
 
 TEST(ImageTexture, EightBitImagesReadBackExactly) {
