@@ -18,7 +18,9 @@ Runner addTonemapCommand(CLI::App& app) {
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "tonemap", "Tone-map a linear EXR to an 8-bit sRGB PNG (Reinhard et al. 2002, global operator)");
-  cmd->add_option("input", args->input, "Linear EXR (or Radiance HDR; 8- and 16-bit images are read as stored)")->required();
+  cmd->add_option("input", args->input,
+                  "Linear EXR (or Radiance HDR; 8- and 16-bit images are read as stored)")
+      ->required();
   cmd->add_option("-o,--output", args->output, "Output PNG")->required();
   cmd->add_option("--key", args->key, "Key value a: the log-average luminance maps to a (default 0.18)")
       ->check(CLI::PositiveNumber);

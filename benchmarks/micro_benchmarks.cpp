@@ -7,13 +7,13 @@
 #include "accel/disc.h"
 #include "accel/sphere.h"
 #include "accel/triangle.h"
+#include "core/sampling.h"
 #include "materials/gltf_pbr.h"
 #include "materials/lambertian.h"
 #include "materials/mixed.h"
 #include "materials/phong.h"
 #include "materials/specular.h"
 #include "renderer/sampler.h"
-#include "core/sampling.h"
 #include "renderer/scene.h"
 
 #include <benchmark/benchmark.h>

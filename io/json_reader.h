@@ -3,8 +3,8 @@
 // Objects are checked for unknown keys, which are reported with the list of valid ones.
 #pragma once
 
-#include "io/input_error.h"
 #include "core/math.h"
+#include "io/input_error.h"
 
 #include <nlohmann/json.hpp>
 

@@ -17,7 +17,8 @@ void clearPendingFile();
 // Async-signal-safe to call and to read: a fixed buffer, "" when nothing is being written.
 const char* pendingFile();
 
-// Calls write(temporary path) — a temporary with the target's extension — then renames it to `path`; on failure removes it and rethrows.
+// Calls write(temporary path) — a temporary with the target's extension — then renames it to `path`; on
+// failure removes it and rethrows.
 template <typename WriteFn>
 void writeAtomically(const std::string& path, WriteFn write) {
   namespace fs = std::filesystem;

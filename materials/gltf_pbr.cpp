@@ -43,8 +43,8 @@
 // specified all the same.
 #include "materials/gltf_pbr.h"
 
-#include "materials/fresnel.h"
 #include "core/sampling.h"
+#include "materials/fresnel.h"
 
 namespace ember {
 

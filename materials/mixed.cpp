@@ -1,7 +1,7 @@
 #include "materials/mixed.h"
 
-#include "materials/specular.h"
 #include "core/sampling.h"
+#include "materials/specular.h"
 
 namespace ember {
 

@@ -26,9 +26,9 @@
 //  - Reciprocity (Helmholtz for reflection, the eta^2-generalised form for refraction).
 //  - Finite, non-negative eval / pdf / sample weights for random and degenerate directions.
 
+#include "core/rng.h"
 #include "materials/gltf_pbr.h"
 #include "materials/texture.h"
-#include "core/rng.h"
 
 #include <gtest/gtest.h>
 
