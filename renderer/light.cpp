@@ -56,13 +56,26 @@ static float errorBoundWithin(const Bounds& b) {
 }
 
 AreaLight::AreaLight(const Shape* shape, const Color& radiance, bool twoSided)
-    : shape_(shape), radiance_(radiance), twoSided_(twoSided), pError_(errorBoundWithin(shape->bounds())) {}
+    : shape_(shape), radiance_(radiance), twoSided_(twoSided), pError_(errorBoundWithin(shape->bounds())) {
+  if (!twoSided_ && shape_->flat()) {
+    // The plane through one of its points. Its samples lie within pError_ of it; the margin
+    // covers that (twice: two sampled points) and the rounding of the dot products with room.
+    const ShapeSample s = shape_->sampleArea(Vec2(0.5f));
+    if (std::isfinite(glm::dot(s.p, s.n)) && std::abs(glm::length(s.n) - 1.0f) < 1e-3f) {
+      skipsBehind_ = true;
+      planePoint_ = s.p;
+      planeNormal_ = s.n;
+      backMargin_ = 4.0f * pError_ + 1e-5f * maxAbsComponent(s.p);
+    }
+  }
+}
 
 void Light::sampleLanes(const Vec3* refs, const Vec2* us, size_t n, LightSample* out, bool* ok) const {
   for (size_t i = 0; i < n; ++i) ok[i] = sample(refs[i], us[i], out[i]);
 }
 
 bool AreaLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
+  if (seesOnlyBack(ref)) return false;  // as sampleLanes
   ShapeSample s;
   float pdf;
   // pdf > 0 decides, as in sampleLanes, whatever the shape returned.
@@ -71,20 +84,31 @@ bool AreaLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
 
 void AreaLight::sampleLanes(const Vec3* refs, const Vec2* us, size_t n, LightSample* out, bool* ok) const {
   SolidAngleLanes lanes{};  // shapes without a lane kernel fill only the live lanes
-  for (size_t first = 0; first < n; first += SolidAngleLanes::kMaxLanes) {
-    lanes.n = unsigned(std::min<size_t>(SolidAngleLanes::kMaxLanes, n - first));
-    for (unsigned i = 0; i < lanes.n; ++i) lanes.set(i, refs[first + i], us[first + i]);
+  size_t query[SolidAngleLanes::kMaxLanes];
+  for (size_t next = 0; next < n;) {
+    // The next block of queries that can see the light's emitting side. The lanes are
+    // independent: a query's sample does not depend on which others share its block.
+    lanes.n = 0;
+    for (; next < n && lanes.n < SolidAngleLanes::kMaxLanes; ++next) {
+      if (seesOnlyBack(refs[next])) {
+        ok[next] = false;
+        continue;
+      }
+      query[lanes.n] = next;
+      lanes.set(lanes.n++, refs[next], us[next]);
+    }
+    if (lanes.n == 0) break;
     lanes.padFrom(lanes.n);
     shape_->sampleSolidAngleLanes(lanes);
     // fromShapeSample for the block: its directions in one kernel, equal to the scalar's.
     LightDirectionLanes dirs;
     lightDirectionLanes(lanes, dirs);
     for (unsigned i = 0; i < lanes.n; ++i) {
-      ok[first + i] = lanes.pdf[i] > 0.0f && dirs.dist[i] != 0.0f;
-      if (ok[first + i])
+      const size_t q = query[i];
+      ok[q] = lanes.pdf[i] > 0.0f && dirs.dist[i] != 0.0f;
+      if (ok[q])
         fillSample({lanes.point(i), lanes.normalAt(i)}, lanes.pdf[i], dirs.dist[i],
-                   Vec3(dirs.wi[0][i], dirs.wi[1][i], dirs.wi[2][i]), (dirs.facing >> i) & 1u,
-                   out[first + i]);
+                   Vec3(dirs.wi[0][i], dirs.wi[1][i], dirs.wi[2][i]), (dirs.facing >> i) & 1u, out[q]);
     }
   }
 }

@@ -123,6 +123,13 @@ class AreaLight final : public Light {
   const Color& radiance() const { return radiance_; }
   bool twoSided() const { return twoSided_; }
   float pointError() const { return pError_; }  // of the shape's sampled points
+  // Whether `ref` lies clearly behind a one-sided flat emitter: every sample of it would face away
+  // (Li black), so sampleLanes skips the lane and reports no sample, as shadowFor would have
+  // discarded it. "Clearly" is a margin far above the rounding of the facing test.
+  bool seesOnlyBack(const Vec3& ref) const {
+    return skipsBehind_ &&
+           glm::dot(ref - planePoint_, planeNormal_) < -(backMargin_ + 1e-5f * maxAbsComponent(ref));
+  }
 
  private:
   // The light sample from the shape's sample (s, pdf) seen from ref.
@@ -135,7 +142,10 @@ class AreaLight final : public Light {
   const Shape* shape_;
   Color radiance_;
   bool twoSided_;
-  float pError_;  // rounding-error bound of the shape's sampled points
+  float pError_;              // rounding-error bound of the shape's sampled points
+  bool skipsBehind_ = false;  // one-sided and flat: refs behind its plane see no light
+  Vec3 planePoint_{0.0f}, planeNormal_{0.0f};
+  float backMargin_ = 0.0f;
 };
 
 class TriangleLight final : public Light {

@@ -4,6 +4,7 @@
 // equal bit for bit. The quad's kernel (SIMD inverse trigonometry) must also agree with the scalar
 // spherical-rectangle and area-sampling formulas it replaces, to float precision; its
 // distribution is checked by the chi-square tests of tests/test_chi2.cpp.
+#include "accel/disc.h"
 #include "accel/flipped_shape.h"
 #include "accel/sphere.h"
 #include "accel/spherical_rectangle.h"
@@ -266,6 +267,82 @@ TEST(SamplingLanes, AreaLightLanesEqualSingleSamples) {
     }
   }
   EXPECT_GT(sampledLights, 500u);
+}
+
+// A one-sided flat emitter skips the references behind it (AreaLight::seesOnlyBack) without sampling
+// them: that is only right where every sample of the shape would face away from the reference, so
+// that the skipped sample's Li would have been black. Checked for a quad, a disc, a triangle and a
+// flipped quad, at three scales and offsets from the origin, for references at random and at
+// signed distances from the plane down to 1e-7 of the scale, with the facing test of
+// AreaLight::fromShapeSample on samples the shape itself draws.
+TEST(SamplingLanes, OneSidedFlatLightsSkipOnlyReferencesNoSampleFaces) {
+  Rng rng(29, 5);
+  size_t skipped = 0, sampledBehind = 0, flatShapes = 0;
+  for (const float scale : {1e-3f, 1.0f, 1e3f})
+    for (const Vec3 offset : {Vec3(0.0f), Vec3(3.0f, -2.0f, 5.0f) * scale, Vec3(1e4f, 0.0f, -1e4f)}) {
+      const Vec3 a = offset + scale * Vec3(-0.5f, 0.2f, -0.4f), b = offset + scale * Vec3(0.6f, 0.3f, -0.3f),
+                 c = offset + scale * Vec3(0.5f, 0.4f, 0.7f);
+      const Vec3 d = a + (c - b);  // a parallelogram a, b, c, d
+      const Vec3 n = glm::normalize(glm::cross(b - a, d - a));
+      const std::array<Vec2, 4> uv4 = {Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)};
+      std::vector<std::unique_ptr<Shape>> shapes;
+      shapes.push_back(std::make_unique<Quad>(std::array<Vec3, 4>{a, b, c, d}, uv4));
+      shapes.push_back(std::make_unique<Disc>(0.5f * (a + c), n, 0.4f * scale));
+      shapes.push_back(std::make_unique<Triangle>(std::array<Vec3, 3>{a, b, c},
+                                                  std::array<Vec2, 3>{Vec2(0, 0), Vec2(1, 0), Vec2(1, 1)}));
+      shapes.push_back(
+          std::make_unique<FlippedShape>(std::make_unique<Quad>(std::array<Vec3, 4>{a, b, c, d}, uv4)));
+      const float y = offset.y + 0.3f * scale;  // an axis-aligned rectangle, as a ceiling light
+      const std::array<Vec3, 4> rectangle = {Vec3(a.x, y, a.z), Vec3(a.x, y, c.z), Vec3(c.x, y, c.z),
+                                             Vec3(c.x, y, a.z)};
+      shapes.push_back(std::make_unique<Quad>(rectangle, uv4));
+      shapes.push_back(std::make_unique<FlippedShape>(std::make_unique<Quad>(rectangle, uv4)));
+      for (const auto& shape : shapes) {
+        if (!shape->flat()) continue;  // a parallelogram whose halves' planes round apart
+        ++flatShapes;
+        const AreaLight light(shape.get(), Color(1.0f));
+        const Vec3 normal = shape->sampleArea(Vec2(0.5f)).n;
+        std::vector<Vec3> refs;
+        for (int i = 0; i < 64; ++i) {
+          // In the plane, within the shape and around it.
+          const Vec3 p1 = shape->sampleArea(next2(rng)).p, p2 = shape->sampleArea(next2(rng)).p;
+          const Vec3 onPlane = p1 + next2(rng).x * (p1 - p2);
+          const float distance = scale * std::pow(10.0f, -7.0f + 7.0f * next2(rng).x);
+          refs.push_back(onPlane + (i % 2 ? distance : -distance) * normal);
+          refs.push_back(offset + scale * 3.0f * (Vec3(next2(rng), next2(rng).x) - Vec3(0.5f)));
+        }
+        std::vector<Vec2> us(refs.size());
+        for (Vec2& u : us) u = next2(rng);
+        std::vector<LightSample> out(refs.size());
+        std::unique_ptr<bool[]> ok(new bool[refs.size()]);
+        light.sampleLanes(refs.data(), us.data(), refs.size(), out.data(), ok.get());
+        for (size_t i = 0; i < refs.size(); ++i) {
+          if (!light.seesOnlyBack(refs[i])) continue;
+          EXPECT_FALSE(ok[i]) << i;
+          bool anySample = false;
+          for (int k = 0; k < 16; ++k) {
+            ShapeSample s;
+            float pdf = 0.0f;
+            if (!shape->sampleSolidAngle(refs[i], next2(rng), s, pdf) || !(pdf > 0.0f)) continue;
+            const Vec3 toLight = s.p - refs[i];
+            const float dist = glm::length(toLight);
+            if (dist == 0.0f) continue;
+            anySample = true;
+            EXPECT_FALSE(glm::dot(-(toLight / dist), s.n) > 0.0f)
+                << shape->typeName() << " scale " << scale << ": ref " << i
+                << " skipped, but a sample faces it";
+          }
+          if (anySample) ++skipped;
+        }
+        for (size_t i = 0; i < refs.size(); ++i)
+          if (!light.seesOnlyBack(refs[i]) &&
+              glm::dot(refs[i] - shape->sampleArea(Vec2(0.5f)).p, normal) < 0.0f)
+            ++sampledBehind;
+      }
+    }
+  EXPECT_GE(flatShapes, 36u);     // the disc, the triangle and the rectangles in every case
+  EXPECT_GT(skipped, 1000u);      // the skip is exercised
+  EXPECT_GT(sampledBehind, 50u);  // and references within the margin behind are still sampled
 }
 
 // The cosine kernel against the scalar warp (core/sampling.h) and frame (core/math.h): the same
