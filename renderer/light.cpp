@@ -146,7 +146,8 @@ TriangleLight::TriangleLight(const TriangleMesh* mesh, uint32_t prim, const Colo
       texture_(texture),
       twoSided_(twoSided),
       pError_(mesh->pointError(prim)),
-      area_(mesh->triangleArea(prim)) {}
+      area_(mesh->triangleArea(prim)),
+      backMargin_(4.0f * pError_ + 1e-5f * maxAbsComponent(v_[0])) {}
 
 float TriangleLight::pdf(const Vec3& ref, const Vec3& p, const Vec3& n) const {
   if (const auto st = sphericalTriangleForSampling(ref, v_[0], v_[1], v_[2], area_))
@@ -155,6 +156,7 @@ float TriangleLight::pdf(const Vec3& ref, const Vec3& p, const Vec3& n) const {
 }
 
 bool TriangleLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
+  if (seesOnlyBack(ref)) return false;
   // Barycentrics (b1, b2) of vertices 1 and 2: where a direction uniform in the solid angle meets
   // the triangle, or a point uniform by area.
   Vec2 b;

@@ -108,6 +108,15 @@ class DirectionalLight final : public Light {
   Color irradiance_;
 };
 
+// Whether `ref` lies behind the plane through `point` with unit normal `n` by more than `margin`
+// plus 1e-5 of ref's coordinates: then a one-sided emitter in that plane shows it only its back,
+// and the facing test of each of its samples (dot(-wi, n) > 0, whose rounding is a few ulps of 1)
+// says so, as long as `margin` covers how far the samples may lie off the plane. Such a reference
+// gets no light sample: every one would carry Li = 0, which next-event estimation drops anyway.
+inline bool clearlyBehind(const Vec3& ref, const Vec3& point, const Vec3& n, float margin) {
+  return glm::dot(ref - point, n) < -(margin + 1e-5f * maxAbsComponent(ref));
+}
+
 class AreaLight final : public Light {
  public:
   AreaLight(const Shape* shape, const Color& radiance, bool twoSided = false);
@@ -127,8 +136,7 @@ class AreaLight final : public Light {
   // (Li black), so sampleLanes skips the lane and reports no sample, as shadowFor would have
   // discarded it. "Clearly" is a margin far above the rounding of the facing test.
   bool seesOnlyBack(const Vec3& ref) const {
-    return skipsBehind_ &&
-           glm::dot(ref - planePoint_, planeNormal_) < -(backMargin_ + 1e-5f * maxAbsComponent(ref));
+    return skipsBehind_ && clearlyBehind(ref, planePoint_, planeNormal_, backMargin_);
   }
 
  private:
@@ -163,6 +171,11 @@ class TriangleLight final : public Light {
     return (twoSided_ ? 2.0f : 1.0f) * kPi * area_ * radiance_ *
            (texture_ ? texture_->average() : Color(1.0f));
   }
+  // Whether `ref` lies clearly behind a one-sided triangle (clearlyBehind): sample() then returns
+  // no sample, where every one would carry Li = 0.
+  bool seesOnlyBack(const Vec3& ref) const {
+    return !twoSided_ && clearlyBehind(ref, v_[0], ng_, backMargin_);
+  }
 
  private:
   const TriangleMesh* mesh_;
@@ -177,6 +190,7 @@ class TriangleLight final : public Light {
   bool twoSided_;
   float pError_;  // rounding-error bound of the triangle's sampled points
   float area_;
+  float backMargin_;  // seesOnlyBack's: the sampled points' error, twice, and the vertex's rounding
 };
 
 // Radiance arriving from infinitely far away: a constant colour, or an equirectangular map

@@ -627,11 +627,13 @@ void triangleLightCase(uint64_t seed) {
   runDirectional(c);
 }
 
-// From close by (0.15 in front of the triangle, off its centroid) TriangleLight samples the
-// spherical triangle (accel/spherical_triangle.h): uniform in solid angle, pdf 1 / omega.
+// From close by (0.15 from the triangle, off its centroid) TriangleLight samples the spherical
+// triangle (accel/spherical_triangle.h): uniform in solid angle, pdf 1 / omega. The reference lies
+// behind the triangle's front face, where a one-sided light gives no sample (seesOnlyBack): the
+// light is two-sided here, which changes no direction or density.
 void triangleLightNearCase(uint64_t seed) {
   const TriangleMesh mesh = lightMesh();
-  const TriangleLight light(&mesh, 1, Color(2.0f));
+  const TriangleLight light(&mesh, 1, Color(2.0f), nullptr, /*twoSided=*/true);
   const Vec3 &a = mesh.positions[1], &b = mesh.positions[3], &cc = mesh.positions[2];
   const Vec3 centroid = (a + b + cc) / 3.0f;
   const Vec3 ref = centroid - 0.15f * glm::normalize(glm::cross(b - a, cc - a)) + 0.2f * (b - centroid);

@@ -9,6 +9,7 @@
 #include "accel/sphere.h"
 #include "accel/spherical_rectangle.h"
 #include "accel/triangle.h"
+#include "accel/triangle_mesh.h"
 #include "core/rng.h"
 #include "core/sampling.h"
 #include "core/warp_lanes.h"
@@ -271,13 +272,14 @@ TEST(SamplingLanes, AreaLightLanesEqualSingleSamples) {
 
 // A one-sided flat emitter skips the references behind it (AreaLight::seesOnlyBack) without sampling
 // them: that is only right where every sample of the shape would face away from the reference, so
-// that the skipped sample's Li would have been black. Checked for a quad, a disc, a triangle and a
-// flipped quad, at three scales and offsets from the origin, for references at random and at
-// signed distances from the plane down to 1e-7 of the scale, with the facing test of
-// AreaLight::fromShapeSample on samples the shape itself draws.
+// that the skipped sample's Li would have been black. Checked for quads (a rectangle, a tilted
+// one, flipped ones), a disc, a triangle and an emissive mesh's triangle (TriangleLight), at three
+// scales and offsets from the origin, for references at random and at signed distances from the
+// plane down to 1e-7 of the scale, with the facing test of AreaLight::fromShapeSample on samples
+// the shape itself draws (for the mesh's triangle, on points all over it).
 TEST(SamplingLanes, OneSidedFlatLightsSkipOnlyReferencesNoSampleFaces) {
   Rng rng(29, 5);
-  size_t skipped = 0, sampledBehind = 0, flatShapes = 0;
+  size_t skipped = 0, sampledBehind = 0, flatShapes = 0, triangleSkips = 0;
   for (const float scale : {1e-3f, 1.0f, 1e3f})
     for (const Vec3 offset : {Vec3(0.0f), Vec3(3.0f, -2.0f, 5.0f) * scale, Vec3(1e4f, 0.0f, -1e4f)}) {
       const Vec3 a = offset + scale * Vec3(-0.5f, 0.2f, -0.4f), b = offset + scale * Vec3(0.6f, 0.3f, -0.3f),
@@ -339,7 +341,29 @@ TEST(SamplingLanes, OneSidedFlatLightsSkipOnlyReferencesNoSampleFaces) {
               glm::dot(refs[i] - shape->sampleArea(Vec2(0.5f)).p, normal) < 0.0f)
             ++sampledBehind;
       }
+      // An emissive mesh's triangle (TriangleLight), against points all over it.
+      TriangleMesh mesh;
+      mesh.positions = {a, b, c};
+      mesh.indices = {glm::uvec3(0, 1, 2)};
+      const TriangleLight triangle(&mesh, 0, Color(1.0f));
+      const Vec3 ng = mesh.surfaceAt(0, 0.0f, 0.0f).ng;
+      for (int i = 0; i < 128; ++i) {
+        const Vec3 p1 = mesh.pointAt(0, next2(rng).x * 0.5f, next2(rng).x * 0.5f);
+        const float distance = scale * std::pow(10.0f, -7.0f + 7.0f * next2(rng).x);
+        const Vec3 ref = p1 + 2.0f * (p1 - a) * next2(rng).x + (i % 2 ? distance : -distance) * ng;
+        if (!triangle.seesOnlyBack(ref)) continue;
+        ++triangleSkips;
+        LightSample out;
+        EXPECT_FALSE(triangle.sample(ref, next2(rng), out));
+        for (int k = 0; k < 16; ++k) {
+          const Vec2 u = next2(rng);
+          const Vec3 p = mesh.pointAt(0, u.x * (1.0f - u.y), u.y);
+          const float dist = glm::length(p - ref);
+          if (dist > 0.0f) EXPECT_FALSE(glm::dot(-(p - ref) / dist, ng) > 0.0f) << "triangle scale " << scale;
+        }
+      }
     }
+  EXPECT_GT(triangleSkips, 200u);
   EXPECT_GE(flatShapes, 36u);     // the disc, the triangle and the rectangles in every case
   EXPECT_GT(skipped, 1000u);      // the skip is exercised
   EXPECT_GT(sampledBehind, 50u);  // and references within the margin behind are still sampled
