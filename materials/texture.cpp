@@ -1,5 +1,6 @@
 #include "materials/texture.h"
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cstdint>
@@ -166,8 +167,12 @@ Color ImageTexture::texel(int x, int y) const {
 
 Color ImageTexture::eval(Vec2 uv) const {
   if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return Color(0.0f);
-  const float x = uv.x * float(width_);
-  const float y = uv.y * float(height_);
+  // Finite UVs far outside [0, 1] (a file may hold them, or a texture transform's scale make them)
+  // are held within 2^30 texels: a float that large has no fraction left, so any texel is as right
+  // as another, and the conversion to int below would overflow (undefined; found by fuzz_gltf).
+  constexpr float kMaxTexels = 0x1p30f;
+  const float x = std::clamp(uv.x * float(width_), -kMaxTexels, kMaxTexels);
+  const float y = std::clamp(uv.y * float(height_), -kMaxTexels, kMaxTexels);
   if (filter_ == TextureFilter::Nearest) {
     return scale_ * texel(int(std::floor(x)), int(std::floor(y)));
   }
