@@ -119,9 +119,7 @@ class GltfImporter {
       if (doc.is_object())
         for (const char* key : {"accessors", "buffers", "meshes", "nodes"})
           if (doc.contains(key) && doc[key].is_object())
-            fail(key,
-                 "an object keyed by id, as in glTF 1.0; Ember reads glTF 2.0 (convert the file, e.g. "
-                 "with the Khronos glTF-Pipeline or Blender's glTF 2.0 exporter)");
+            fail(key, std::string("an object keyed by id, as in glTF 1.0; ") + kReadsOnlyGltf2);
       for (const std::string& ext : requiredExtensions(doc))
         if (!supportedExtensions().count(ext))
           fail("extensionsRequired", "the file requires " + ext + ", which Ember does not support");
@@ -152,6 +150,11 @@ class GltfImporter {
     return nlohmann::json::parse(bytes, nullptr, /*allow_exceptions=*/false);
   }
 
+  // The end of every message refusing a file of another glTF version.
+  static constexpr const char* kReadsOnlyGltf2 =
+      "Ember reads glTF 2.0 (convert the file, e.g. with the Khronos glTF-Pipeline or Blender's glTF 2.0 "
+      "exporter)";
+
   // glTF 1.0 files (collada2gltf and other early exporters) follow another schema, which tinygltf
   // reads as an empty 2.0 model or refuses with a message about its symptoms: name the version.
   // As the 2.0 specification asks of loaders (section 3.2, "Asset"), a file whose major version
@@ -176,10 +179,7 @@ class GltfImporter {
     if (!version.empty()) {
       if (!parse(version, major, minor))
         fail("asset.version", "'" + version + "' is not a glTF version of the form <major>.<minor>");
-      if (major != 2)
-        fail("asset.version", "the file is glTF " + version +
-                                  "; Ember reads glTF 2.0 (convert it, e.g. with " +
-                                  "the Khronos glTF-Pipeline or Blender's glTF 2.0 exporter)");
+      if (major != 2) fail("asset.version", "the file is glTF " + version + "; " + kReadsOnlyGltf2);
     }
     if (!minVersion.empty()) {
       if (!parse(minVersion, major, minor))
