@@ -10,7 +10,10 @@ script is committed), into --out:
   demo-1080p  scenes/demo.json at 1920 x 1080 (Ember only: its cone, Phong and mixed materials
               have no Mitsuba equivalent in benchmarks/mitsuba_scene.py)
 
-Mitsuba gets the same triangles as PLY files. Needs numpy, and mitsuba for the comparison:
+Mitsuba gets the same triangles as PLY files, and both renderers the same materials: the JSON
+scenes give the glTF meshes Ember's `diffuse` (the spheres white, the emitters black), as Mitsuba's
+`diffuse` BSDFs, rather than the files' glTF metallic-roughness materials, whose specular lobe
+Mitsuba's scenes do not have. Needs numpy, and mitsuba for the comparison:
 
     /tmp/mi/bin/python benchmarks/scaling_scenes.py --out /tmp/scaling            # write + run
     DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1 /tmp/mi/bin/python \\
@@ -131,7 +134,7 @@ def make_mesh_1m(out):
     scene = {"image": {"width": 256, "height": 256}, "camera": CAMERA,
              "render": {"spp": 16, "max_depth": -1, "rr_depth": 5},
              "materials": {"white": {"type": "diffuse", "reflectance": [0.7, 0.7, 0.7]}},
-             "shapes": [{"type": "mesh", "file": "spheres.glb"},
+             "shapes": [{"type": "mesh", "file": "spheres.glb", "material": "white"},
                         {"type": "quad", "material": "white", "vertices": FLOOR},
                         {"type": "quad", "emission": [40, 40, 40],
                          "vertices": [[-0.5, 6, -0.5], [0.5, 6, -0.5], [0.5, 6, 0.5], [-0.5, 6, 0.5]]}]}
@@ -157,8 +160,9 @@ def make_emitters_10k(out, n=100):
     write_ply(os.path.join(out, "emitters.ply"), v, idx)
     scene = {"image": {"width": 256, "height": 256}, "camera": CAMERA,
              "render": {"spp": 16, "max_depth": -1, "rr_depth": 5},
-             "materials": {"white": {"type": "diffuse", "reflectance": [0.7, 0.7, 0.7]}},
-             "shapes": [{"type": "mesh", "file": "emitters.glb"},
+             "materials": {"white": {"type": "diffuse", "reflectance": [0.7, 0.7, 0.7]},
+                           "black": {"type": "diffuse", "reflectance": [0.0, 0.0, 0.0]}},
+             "shapes": [{"type": "mesh", "file": "emitters.glb", "material": "black"},
                         {"type": "quad", "material": "white", "vertices": FLOOR},
                         {"type": "sphere", "center": [0, 1, 0], "radius": 1, "material": "white"}]}
     with open(os.path.join(out, "emitters-10k.json"), "w") as f:
@@ -183,7 +187,8 @@ def mitsuba_dict(name, out, spp):
         scene["light"] = {"type": "rectangle", "to_world": T.translate([0, 6, 0]) @ T.scale(0.5) @ T.rotate([1, 0, 0], 90),
                           "emitter": {"type": "area", "radiance": {"type": "rgb", "value": [40] * 3}}}
     else:
-        scene["emitters"] = {"type": "ply", "filename": os.path.join(out, "emitters.ply"),
+        black = {"type": "twosided", "material": {"type": "diffuse", "reflectance": {"type": "rgb", "value": [0.0] * 3}}}
+        scene["emitters"] = {"type": "ply", "filename": os.path.join(out, "emitters.ply"), "bsdf": black,
                              "emitter": {"type": "area", "radiance": {"type": "rgb", "value": [3] * 3}}}
         scene["sphere"] = {"type": "sphere", "center": [0, 1, 0], "radius": 1.0, "bsdf": white}
     return scene
