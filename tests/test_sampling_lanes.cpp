@@ -359,7 +359,9 @@ TEST(SamplingLanes, OneSidedFlatLightsSkipOnlyReferencesNoSampleFaces) {
           const Vec2 u = next2(rng);
           const Vec3 p = mesh.pointAt(0, u.x * (1.0f - u.y), u.y);
           const float dist = glm::length(p - ref);
-          if (dist > 0.0f) EXPECT_FALSE(glm::dot(-(p - ref) / dist, ng) > 0.0f) << "triangle scale " << scale;
+          if (dist > 0.0f) {
+            EXPECT_FALSE(glm::dot(-(p - ref) / dist, ng) > 0.0f) << "triangle scale " << scale;
+          }
         }
       }
     }
