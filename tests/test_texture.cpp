@@ -9,12 +9,14 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <utility>
 #include <vector>
 
 namespace ember {
@@ -165,6 +167,57 @@ TEST(ImageTexture, BilinearLookupsAgreeBetweenPaletteAndFloats) {
     const Color ca = a.eval(uv), cb = b.eval(uv);
     for (int c = 0; c < 3; ++c) ASSERT_EQ(bitsOf(ca[c]), bitsOf(cb[c])) << "uv " << uv.x << " " << uv.y;
   }
+}
+
+// Wrapping as the glTF sampler modes define it, written out plainly: the reference for
+// ImageTexture's cheaper forms (one division per axis for repeat).
+int referenceWrap(int i, int n, TextureWrap wrap) {
+  switch (wrap) {
+    case TextureWrap::Clamp:
+      return std::min(std::max(i, 0), n - 1);
+    case TextureWrap::Repeat:
+      return ((i % n) + n) % n;
+    case TextureWrap::Mirror:
+      break;
+  }
+  const int m = ((i % (2 * n)) + 2 * n) % (2 * n);
+  return m < n ? m : 2 * n - 1 - m;
+}
+
+// Bilinear and nearest lookups equal the formula with every texel coordinate wrapped on its own,
+// bit for bit: every wrap mode (each axis its own), images one texel wide and odd sizes, UVs far
+// outside the image on either side and on the seams.
+TEST(ImageTexture, WrappedLookupsEqualTheReferenceFormula) {
+  Rng rng(17, 4);
+  const TextureWrap modes[] = {TextureWrap::Clamp, TextureWrap::Repeat, TextureWrap::Mirror};
+  for (const auto& [w, h] : {std::pair{1, 1}, std::pair{1, 3}, std::pair{2, 5}, std::pair{7, 3}})
+    for (const TextureWrap ws : modes)
+      for (const TextureWrap wt : modes) {
+        std::vector<Color> texels(size_t(w * h));
+        for (Color& t : texels) t = Color(rng.uniform(), rng.uniform() * 4.0f, 1000.0f * rng.uniform());
+        const ImageTexture bilinear(w, h, texels, TextureFilter::Bilinear, ws, wt, Color(1.0f));
+        const ImageTexture nearest(w, h, texels, TextureFilter::Nearest, ws, wt, Color(1.0f));
+        const auto at = [&](int x, int y) {
+          return texels[size_t(referenceWrap(y, h, wt)) * size_t(w) + size_t(referenceWrap(x, w, ws))];
+        };
+        for (int i = 0; i < 400; ++i) {
+          const float range = i % 4 == 0 ? 1e6f : i % 4 == 1 ? 3.0f : 1.0f;
+          Vec2 uv(range * (2.0f * rng.uniform() - 1.0f), range * (2.0f * rng.uniform() - 1.0f));
+          if (i % 7 == 0) uv = Vec2(float(i % 5 - 2) / float(w), float(i % 3 - 1) / float(h));  // seams
+          const float fx = uv.x * float(w) - 0.5f, fy = uv.y * float(h) - 0.5f;
+          const int x0 = int(std::floor(fx)), y0 = int(std::floor(fy));
+          const float tx = fx - float(x0), ty = fy - float(y0);
+          const Color want = glm::mix(glm::mix(at(x0, y0), at(x0 + 1, y0), tx),
+                                      glm::mix(at(x0, y0 + 1), at(x0 + 1, y0 + 1), tx), ty);
+          const Color got = bilinear.eval(uv);
+          const Color wantNearest = at(int(std::floor(uv.x * float(w))), int(std::floor(uv.y * float(h))));
+          const Color gotNearest = nearest.eval(uv);
+          for (int c = 0; c < 3; ++c) {
+            ASSERT_EQ(bitsOf(got[c]), bitsOf(want[c])) << w << "x" << h << " uv " << uv.x << " " << uv.y;
+            ASSERT_EQ(bitsOf(gotNearest[c]), bitsOf(wantNearest[c])) << w << "x" << h;
+          }
+        }
+      }
 }
 
 }  // namespace
