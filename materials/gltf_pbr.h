@@ -19,6 +19,7 @@
 #include "materials/microfacet.h"
 #include "materials/texture.h"
 
+#include <cstdint>
 #include <memory>
 
 namespace ember {
@@ -69,6 +70,9 @@ class GltfPbrMaterial final : public Material {
   };
 
   Params fetch(Vec2 uv) const;
+  // fetch(hit.uv), remembered for the hit: a vertex asks twice (the light sample's evalPdf, then
+  // sample), and the textures' lookups were a third of a textured glTF render.
+  const Params& fetchFor(const SurfaceHit& hit) const;
   LobeProbabilities lobeProbabilities(const Params& p, float cosO, bool outside) const;
   // Fresnel reflectance of the dielectric layer for the cosine between wo and the microfacet normal.
   float dielectricFresnel(float cosOH, bool outside) const;
@@ -82,6 +86,7 @@ class GltfPbrMaterial final : public Material {
   float ior_;      // max(ior, 1)
   float f0_;       // ((ior - 1) / (ior + 1))^2, the dielectric's normal-incidence reflectance
   bool refracts_;  // a volumetric (bending) transmission lobe: !thinWalled and ior_ > 1
+  uint64_t id_;    // unique in the process, never 0: fetchFor's key
 };
 
 }  // namespace ember

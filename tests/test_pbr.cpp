@@ -35,11 +35,15 @@
 #include "mc_mean.h"
 #include "test_fixtures.h"
 
+#include <array>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -423,6 +427,83 @@ TEST(PbrInputs, MissingTexturesMeanTheGltfDefaults) {
   EXPECT_EQ(defaults.pdf(hit, wo, wi), metal->pdf(hit, wo, wi));
   EXPECT_TRUE(defaults.hasNonDeltaLobes());
   EXPECT_EQ(defaults.typeName(), "gltf_pbr");
+}
+
+// The material's inputs are remembered per hit (GltfPbrMaterial::fetchFor) between a vertex's
+// evalPdf and its sample. Whatever a hit's slot held before (nothing, the same inputs, another
+// UV, another material, a NaN UV), every value must be what a first evaluation gives, bit for bit:
+// the memo may only ever return what fetch would.
+TEST(GltfPbr, RememberedInputsNeverChangeAValue) {
+  std::vector<Color> texels(64 * 64);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x)
+      texels[size_t(y * 64 + x)] = Color(float(x) / 63.0f, float(y) / 63.0f, float((x * y) % 64) / 63.0f);
+  const auto image =
+      std::make_shared<ImageTexture>(64, 64, texels, TextureFilter::Bilinear, TextureWrap::Repeat);
+  GltfPbrInputs a, b;
+  a.baseColor = image;
+  a.metallicRoughness = image;  // roughness and metallic vary with the UV too
+  b.baseColor = std::make_shared<ConstantTexture>(Color(0.2f, 0.9f, 0.4f));
+  b.metallicRoughness = image;
+  const GltfPbrMaterial first(a), second(b);
+  const GltfPbrMaterial* materials[] = {&first, &second};
+
+  // Many hits side by side, as in a wave, and one on the stack that every case reuses.
+  std::vector<SurfaceHit> wave(2048, flatHit());
+  Rng rng(8, 1);
+  const auto bits = [](const Color& c) {
+    return std::array{std::bit_cast<uint32_t>(c.x), std::bit_cast<uint32_t>(c.y),
+                      std::bit_cast<uint32_t>(c.z)};
+  };
+  for (int round = 0; round < 3000; ++round) {
+    SurfaceHit& hit = wave[size_t(rng.uniform() * 2047.0f)];
+    const GltfPbrMaterial& m = *materials[round % 2];
+    const Vec2 uv = round % 97 == 0  ? Vec2(std::numeric_limits<float>::quiet_NaN(), 0.5f)
+                    : round % 5 == 0 ? hit.uv  // the slot's own UV again
+                                     : Vec2(3.0f * rng.uniform() - 1.0f, 3.0f * rng.uniform() - 1.0f);
+    hit.uv = uv;
+    const Vec3 wo = glm::normalize(Vec3(rng.uniform() - 0.5f, rng.uniform() - 0.5f, 0.1f + rng.uniform()));
+    const Vec3 wi = glm::normalize(Vec3(rng.uniform() - 0.5f, rng.uniform() - 0.5f, 0.1f + rng.uniform()));
+    const Vec2 u(rng.uniform(), rng.uniform());
+    const float uLobe = rng.uniform();
+    float pdf = 0.0f;
+    const Color f = m.evalPdf(hit, wo, wi, pdf);
+    BsdfSample bs;
+    const bool sampled = m.sample(hit, wo, u, uLobe, bs);
+
+    // A first evaluation: a copy of the hit in a slot that a material other than m has just filled
+    // (so m must fetch) and then m itself, twice over.
+    SurfaceHit fresh = hit;
+    const GltfPbrMaterial& other = *materials[(round + 1) % 2];
+    float ignored;
+    other.evalPdf(fresh, wo, wi, ignored);
+    float pdfFresh = 0.0f;
+    const Color fFresh = m.evalPdf(fresh, wo, wi, pdfFresh);
+    BsdfSample bsFresh;
+    const bool sampledFresh = m.sample(fresh, wo, u, uLobe, bsFresh);
+    ASSERT_EQ(bits(f), bits(fFresh)) << "round " << round;
+    ASSERT_EQ(std::bit_cast<uint32_t>(pdf), std::bit_cast<uint32_t>(pdfFresh)) << "round " << round;
+    ASSERT_EQ(sampled, sampledFresh) << "round " << round;
+    if (sampled) {
+      ASSERT_EQ(bits(bs.weight), bits(bsFresh.weight)) << "round " << round;
+      ASSERT_EQ(bits(bs.wi), bits(bsFresh.wi)) << "round " << round;
+    }
+  }
+
+  // A material built where a freed one lay (a second scene, a loop) is another material: at the
+  // same address, for the same hit and UV, it must not get its predecessor's inputs.
+  std::optional<GltfPbrMaterial> reused;
+  const SurfaceHit hit = flatHit();
+  const Vec3 wo(0.0f, 0.0f, 1.0f), wi = glm::normalize(Vec3(0.3f, 0.0f, 1.0f));
+  for (int k = 0; k < 4; ++k) {
+    GltfPbrInputs in;
+    in.baseColor = std::make_shared<ConstantTexture>(Color(0.2f * float(k + 1)));
+    reused.emplace(in);
+    const GltfPbrMaterial alone(in);
+    float pdf, pdfAlone;
+    EXPECT_EQ(bits(reused->evalPdf(hit, wo, wi, pdf)), bits(alone.evalPdf(SurfaceHit(hit), wo, wi, pdfAlone)))
+        << "material " << k << " at the address of material " << k - 1;
+  }
 }
 
 }  // namespace
