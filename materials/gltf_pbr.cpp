@@ -49,7 +49,6 @@
 #include <array>
 #include <atomic>
 #include <bit>
-#include <cstdint>
 
 namespace ember {
 
@@ -72,8 +71,9 @@ GltfPbrMaterial::GltfPbrMaterial(GltfPbrInputs inputs)
 // would: images cannot change. The memo is per thread (no locks, nothing allocated per sample) and
 // direct-mapped by the hit's address, so that the wave's vertices, whose hits lie side by side,
 // each keep their own slot between the bounce's light samples and its BSDF samples (1,024 slots:
-// a wave's vertices, packet/wavefront_integrator.cpp); any other hit finds the key different and
-// fetches. UVs are compared bit for bit: equal keys are equal inputs.
+// WavefrontIntegrator::kWaveSize, which this layer cannot include; a mismatch would only cost
+// lookups); any other hit finds the key different and fetches. UVs are compared bit for bit:
+// equal keys are equal inputs.
 const GltfPbrMaterial::Params& GltfPbrMaterial::fetchFor(const SurfaceHit& hit) const {
   struct Slot {
     uint64_t material = 0;  // GltfPbrMaterial::id_; 0: none yet

@@ -491,17 +491,24 @@ TEST(GltfPbr, RememberedInputsNeverChangeAValue) {
   }
 
   // A material built where a freed one lay (a second scene, a loop) is another material: at the
-  // same address, for the same hit and UV, it must not get its predecessor's inputs.
-  std::optional<GltfPbrMaterial> reused;
+  // same address, for the same hit and UV, it must not get its predecessor's inputs. The values
+  // it must give come from materials that all stay alive (each its own address and id).
   const SurfaceHit hit = flatHit();
   const Vec3 wo(0.0f, 0.0f, 1.0f), wi = glm::normalize(Vec3(0.3f, 0.0f, 1.0f));
+  std::vector<std::unique_ptr<GltfPbrMaterial>> alive;
+  std::vector<Color> want;
   for (int k = 0; k < 4; ++k) {
     GltfPbrInputs in;
     in.baseColor = std::make_shared<ConstantTexture>(Color(0.2f * float(k + 1)));
-    reused.emplace(in);
-    const GltfPbrMaterial alone(in);
-    float pdf, pdfAlone;
-    EXPECT_EQ(bits(reused->evalPdf(hit, wo, wi, pdf)), bits(alone.evalPdf(SurfaceHit(hit), wo, wi, pdfAlone)))
+    alive.push_back(std::make_unique<GltfPbrMaterial>(in));
+    float pdf;
+    want.push_back(alive.back()->evalPdf(hit, wo, wi, pdf));
+  }
+  std::optional<GltfPbrMaterial> reused;
+  for (int k = 0; k < 4; ++k) {
+    reused.emplace(alive[size_t(k)]->inputs());
+    float pdf;
+    EXPECT_EQ(bits(reused->evalPdf(hit, wo, wi, pdf)), bits(want[size_t(k)]))
         << "material " << k << " at the address of material " << k - 1;
   }
 }
