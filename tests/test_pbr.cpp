@@ -431,8 +431,8 @@ TEST(PbrInputs, MissingTexturesMeanTheGltfDefaults) {
 
 // The material's inputs are remembered per hit (GltfPbrMaterial::fetchFor) between a vertex's
 // evalPdf and its sample. Whatever a hit's slot held before (nothing, the same inputs, another
-// UV, another material, a NaN UV), every value must be what a first evaluation gives, bit for bit:
-// the memo may only ever return what fetch would.
+// UV, another material, a NaN UV, a material rebuilt at the same address), every value must be what
+// a first evaluation gives, bit for bit: the memo may only ever return what fetch would.
 TEST(GltfPbr, RememberedInputsNeverChangeAValue) {
   std::vector<Color> texels(64 * 64);
   for (int y = 0; y < 64; ++y)
@@ -448,7 +448,7 @@ TEST(GltfPbr, RememberedInputsNeverChangeAValue) {
   const GltfPbrMaterial first(a), second(b);
   const GltfPbrMaterial* materials[] = {&first, &second};
 
-  // Many hits side by side, as in a wave, and one on the stack that every case reuses.
+  // Many hits side by side, as in a wave; each round also evaluates a copy of its hit.
   std::vector<SurfaceHit> wave(2048, flatHit());
   Rng rng(8, 1);
   const auto bits = [](const Color& c) {
