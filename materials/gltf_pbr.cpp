@@ -45,51 +45,19 @@
 
 #include "core/sampling.h"
 #include "materials/fresnel.h"
-
-#include <array>
-#include <atomic>
-#include <bit>
+#include "materials/hit_memo.h"
 
 namespace ember {
 
-namespace {
-// Material ids for fetchFor's memo, never reused in a process: a material built where a freed one
-// lay (a second scene, or a test's loop) has another id than its predecessor, where the address
-// would have been the same key and returned the old material's inputs.
-std::atomic<uint64_t> nextMaterialId{1};
-}  // namespace
-
-GltfPbrMaterial::GltfPbrMaterial(GltfPbrInputs inputs)
-    : inputs_(std::move(inputs)), id_(nextMaterialId.fetch_add(1, std::memory_order_relaxed)) {
+GltfPbrMaterial::GltfPbrMaterial(GltfPbrInputs inputs) : inputs_(std::move(inputs)), id_(newHitMemoOwner()) {
   ior_ = std::max(inputs_.ior, 1.0f);
   const float r = (ior_ - 1.0f) / (ior_ + 1.0f);
   f0_ = r * r;  // 0.04 at ior 1.5 (glTF B.3.4, KHR_materials_ior)
   refracts_ = !inputs_.thinWalled && ior_ > 1.0f + 1e-3f;
 }
 
-// fetch is a pure function of (material id, uv), so a memo keyed by both returns exactly what it
-// would: images cannot change. The memo is per thread (no locks, nothing allocated per sample) and
-// direct-mapped by the hit's address, so that the wave's vertices, whose hits lie side by side,
-// each keep their own slot between the bounce's light samples and its BSDF samples (1,024 slots:
-// WavefrontIntegrator::kWaveSize, which this layer cannot include; a mismatch would only cost
-// lookups); any other hit finds the key different and fetches. UVs are compared bit for bit:
-// equal keys are equal inputs.
 const GltfPbrMaterial::Params& GltfPbrMaterial::fetchFor(const SurfaceHit& hit) const {
-  struct Slot {
-    uint64_t material = 0;  // GltfPbrMaterial::id_; 0: none yet
-    uint64_t uvBits = 0;
-    Params params{Color(0.0f), 0.0f, 0.0f, Ggx::fromRoughness(1.0f)};
-  };
-  static constexpr size_t kSlots = 1024;
-  thread_local std::array<Slot, kSlots> memo;
-  Slot& slot = memo[(reinterpret_cast<uintptr_t>(&hit) / sizeof(SurfaceHit)) % kSlots];
-  const uint64_t uvBits = std::bit_cast<uint64_t>(hit.uv);
-  if (slot.material != id_ || slot.uvBits != uvBits) {
-    slot.params = fetch(hit.uv);
-    slot.material = id_;
-    slot.uvBits = uvBits;
-  }
-  return slot.params;
+  return HitMemo<Params, GltfPbrMaterial>::at(hit, id_, [&] { return fetch(hit.uv); });
 }
 
 GltfPbrMaterial::Params GltfPbrMaterial::fetch(Vec2 uv) const {

@@ -41,8 +41,7 @@ struct GltfPbrInputs {
 class GltfPbrMaterial final : public Material {
  public:
   explicit GltfPbrMaterial(GltfPbrInputs inputs);
-  // Not copied or moved: fetchFor's memo keys a material's inputs by its id, which a moved-from
-  // object would keep with other (emptied) inputs.
+  // Not copied or moved: fetchFor's memo keys a material's inputs by its id (materials/hit_memo.h).
   GltfPbrMaterial(const GltfPbrMaterial&) = delete;
   GltfPbrMaterial& operator=(const GltfPbrMaterial&) = delete;
 
@@ -64,9 +63,9 @@ class GltfPbrMaterial final : public Material {
  private:
   // The inputs at one surface point.
   struct Params {
-    Color baseColor;
-    float metallic, transmission;
-    Ggx ggx;
+    Color baseColor{0.0f};
+    float metallic = 0.0f, transmission = 0.0f;
+    Ggx ggx = Ggx::fromRoughness(1.0f);
   };
   // Probabilities with which sample() picks its lobes (they sum to 1).
   struct LobeProbabilities {
@@ -74,9 +73,9 @@ class GltfPbrMaterial final : public Material {
   };
 
   Params fetch(Vec2 uv) const;
-  // fetch(hit.uv), remembered for the hit: a vertex asks twice (the light sample's evalPdf, then
-  // sample), and the textures' lookups in those two calls were 16% of a textured glTF render's
-  // instructions. The reference stays valid until the thread's next fetchFor.
+  // fetch(hit.uv), remembered for the hit (materials/hit_memo.h): a vertex asks twice, for the
+  // light sample's evalPdf and for sample. The reference stays valid until the thread's next
+  // fetchFor.
   const Params& fetchFor(const SurfaceHit& hit) const;
   LobeProbabilities lobeProbabilities(const Params& p, float cosO, bool outside) const;
   // Fresnel reflectance of the dielectric layer for the cosine between wo and the microfacet normal.
@@ -91,7 +90,7 @@ class GltfPbrMaterial final : public Material {
   float ior_;      // max(ior, 1)
   float f0_;       // ((ior - 1) / (ior + 1))^2, the dielectric's normal-incidence reflectance
   bool refracts_;  // a volumetric (bending) transmission lobe: !thinWalled and ior_ > 1
-  uint64_t id_;    // unique in the process, never 0: fetchFor's key
+  uint64_t id_;    // fetchFor's memo key: newHitMemoOwner()
 };
 
 }  // namespace ember

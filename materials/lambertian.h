@@ -30,7 +30,7 @@ class Lambertian final : public Material {
 
  private:
   bool absorbsEverythingAt(const SurfaceHit& hit) const override {
-    return isBlack(reflectance_->eval(hit.uv));
+    return isBlack(reflectance_->evalAt(hit));
   }
   // The sample from the kernel's direction and pdf.
   bool finishSample(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi, float pdf, BsdfSample& out) const;

@@ -18,19 +18,19 @@ Color Mixed::eval(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const {
   const Vec3 n = facingNormal(hit, wo);
   const float cosI = glm::dot(wi, n);
   if (cosI <= 0.0f) return Color(0.0f);
-  return (c_.kd->eval(hit.uv) * kInvPi + c_.ks * lobe_.value(wi, reflect(wo, n))) * cosI;
+  return (c_.kd->evalAt(hit) * kInvPi + c_.ks * lobe_.value(wi, reflect(wo, n))) * cosI;
 }
 
 float Mixed::pdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const {
   if (!sameSide(hit, wo, wi)) return 0.0f;
   const Vec3 n = facingNormal(hit, wo);
-  const float pd = maxComponent(c_.kd->eval(hit.uv));
+  const float pd = maxComponent(c_.kd->evalAt(hit));
   const float ps = maxComponent(c_.ks);
   return pd * cosineHemispherePdf(glm::dot(wi, n)) + ps * lobe_.pdf(wi, reflect(wo, n));
 }
 
 bool Mixed::sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float uLobe, BsdfSample& out) const {
-  const float pd = maxComponent(c_.kd->eval(hit.uv));
+  const float pd = maxComponent(c_.kd->evalAt(hit));
   const float ps = maxComponent(c_.ks);
   const float pr = maxComponent(c_.kr);
   const float pt = maxComponent(c_.kt);

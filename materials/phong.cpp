@@ -15,19 +15,19 @@ Color Phong::eval(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const {
   const float cosI = glm::dot(wi, n);
   if (cosI <= 0.0f) return Color(0.0f);
   const Vec3 r = reflect(wo, n);
-  return (kd_->eval(hit.uv) * kInvPi + ks_ * lobe_.value(wi, r)) * cosI;
+  return (kd_->evalAt(hit) * kInvPi + ks_ * lobe_.value(wi, r)) * cosI;
 }
 
 float Phong::pdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const {
   if (!sameSide(hit, wo, wi)) return 0.0f;
   const Vec3 n = facingNormal(hit, wo);
-  const float pd = diffuseProbability(kd_->eval(hit.uv));
+  const float pd = diffuseProbability(kd_->evalAt(hit));
   return pd * cosineHemispherePdf(glm::dot(wi, n)) + (1.0f - pd) * lobe_.pdf(wi, reflect(wo, n));
 }
 
 bool Phong::sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float uLobe, BsdfSample& out) const {
   const Vec3 n = facingNormal(hit, wo);
-  const float pd = diffuseProbability(kd_->eval(hit.uv));
+  const float pd = diffuseProbability(kd_->evalAt(hit));
   out.wi = uLobe < pd ? Frame(n).toWorld(sampleCosineHemisphere(u)) : lobe_.sample(reflect(wo, n), u);
   out.pdf = pdf(hit, wo, out.wi);
   if (out.pdf <= 0.0f) return false;

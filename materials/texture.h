@@ -4,6 +4,7 @@
 #pragma once
 
 #include "core/math.h"
+#include "core/surface_hit.h"
 
 #include <array>
 #include <cstdint>
@@ -17,6 +18,9 @@ class Texture {
  public:
   virtual ~Texture() = default;
   virtual Color eval(Vec2 uv) const = 0;
+  // eval(hit.uv) for a material shading `hit`, which asks more than once per vertex: textures
+  // whose lookup costs more than a memo's check remember it per hit (materials/hit_memo.h).
+  virtual Color evalAt(const SurfaceHit& hit) const { return eval(hit.uv); }
   // Largest value the texture can return per channel (used for sampling decisions).
   virtual Color maxValue() const = 0;
   // Mean over the texture's area.
@@ -31,6 +35,7 @@ class ConstantTexture final : public Texture {
  public:
   explicit ConstantTexture(const Color& c) : value_(c) {}
   Color eval(Vec2) const override { return value_; }
+  Color evalAt(const SurfaceHit&) const override { return value_; }
   Color maxValue() const override { return value_; }
   Color average() const override { return value_; }
   bool isConstant() const override { return true; }
@@ -51,7 +56,11 @@ class ImageTexture final : public Texture {
   // wrapS applies along u (columns), wrapT along v (rows), as glTF samplers define them.
   ImageTexture(int width, int height, std::vector<Color> texels, TextureFilter filter, TextureWrap wrapS,
                TextureWrap wrapT, const Color& scale = Color(1.0f));
+  // Not copied or moved: evalAt's memo keys the texture's values by its id (materials/hit_memo.h).
+  ImageTexture(const ImageTexture&) = delete;
+  ImageTexture& operator=(const ImageTexture&) = delete;
   Color eval(Vec2 uv) const override;
+  Color evalAt(const SurfaceHit& hit) const override;
   Color maxValue() const override { return max_; }
   Color average() const override { return average_; }
   bool mayBeBlack() const override { return mayBeBlack_; }
@@ -84,6 +93,7 @@ class ImageTexture final : public Texture {
   // Some scaled texel is black or has a negative channel (whose bilinear blend with another texel
   // could then be black): a blend of texels with neither always has a positive channel.
   bool mayBeBlack_ = false;
+  uint64_t id_;  // evalAt's memo key: newHitMemoOwner()
 };
 
 // KHR_texture_transform: looks `inner` up at uv' = T R S uv (the extension's matrix: offset, then a

@@ -16,6 +16,7 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -218,6 +219,53 @@ TEST(ImageTexture, WrappedLookupsEqualTheReferenceFormula) {
           }
         }
       }
+}
+
+// ImageTexture::evalAt remembers a lookup per hit (materials/hit_memo.h). Whatever a hit's slot
+// held before (nothing, the same texture and UV, another UV, another texture, a NaN UV, a texture
+// rebuilt at the same address), it must return eval(hit.uv) bit for bit.
+TEST(ImageTexture, RememberedLookupsEqualFreshOnes) {
+  Rng rng(21, 4);
+  const auto randomTexels = [&](int n) {
+    std::vector<Color> texels;
+    for (int i = 0; i < n; ++i) texels.emplace_back(rng.uniform(), rng.uniform(), rng.uniform());
+    return texels;
+  };
+  const ImageTexture first(16, 16, randomTexels(256), TextureFilter::Bilinear, TextureWrap::Repeat);
+  const ImageTexture second(16, 16, randomTexels(256), TextureFilter::Nearest, TextureWrap::Mirror);
+  const ImageTexture* textures[] = {&first, &second};
+  std::vector<SurfaceHit> wave(2048);  // hits side by side, as in a wave
+  for (int round = 0; round < 4000; ++round) {
+    SurfaceHit& hit = wave[size_t(rng.uniform() * 2047.0f)];
+    if (round % 97 == 0)
+      hit.uv = Vec2(std::numeric_limits<float>::quiet_NaN(), 0.5f);
+    else if (round % 5 != 0)  // else the slot's own UV again
+      hit.uv = Vec2(3.0f * rng.uniform() - 1.0f, 3.0f * rng.uniform() - 1.0f);
+    const ImageTexture& t = *textures[round % 3 == 0 ? 1 : 0];
+    const Color want = t.eval(hit.uv), got = t.evalAt(hit), again = t.evalAt(hit);
+    for (int c = 0; c < 3; ++c) {
+      ASSERT_EQ(bitsOf(got[c]), bitsOf(want[c])) << "round " << round;
+      ASSERT_EQ(bitsOf(again[c]), bitsOf(want[c])) << "round " << round;
+    }
+  }
+  // Textures built where a freed one lay get their own values, not their predecessor's: the
+  // values to expect come from textures that all stay alive.
+  SurfaceHit hit;
+  hit.uv = Vec2(0.3f, 0.6f);
+  std::vector<std::vector<Color>> images;
+  std::vector<std::unique_ptr<ImageTexture>> alive;
+  for (int k = 0; k < 4; ++k) {
+    images.push_back(randomTexels(4));
+    alive.push_back(
+        std::make_unique<ImageTexture>(2, 2, images.back(), TextureFilter::Nearest, TextureWrap::Clamp));
+  }
+  std::optional<ImageTexture> reused;
+  for (size_t k = 0; k < 4; ++k) {
+    reused.emplace(2, 2, images[k], TextureFilter::Nearest, TextureWrap::Clamp);
+    const Color want = alive[k]->eval(hit.uv), got = reused->evalAt(hit);
+    for (int c = 0; c < 3; ++c)
+      EXPECT_EQ(bitsOf(got[c]), bitsOf(want[c])) << "texture " << k << " at the address of texture " << k - 1;
+  }
 }
 
 }  // namespace
