@@ -14,6 +14,7 @@ class Lambertian final : public Material {
   explicit Lambertian(std::shared_ptr<const Texture> reflectance)
       : reflectance_(std::move(reflectance)), reflects_(!isBlack(reflectance_->maxValue())) {
     mayAbsorb_ = reflectance_->mayBeBlack();
+    usesLobe_ = false;  // one lobe
   }
 
   std::string_view typeName() const override { return "diffuse"; }

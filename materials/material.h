@@ -48,6 +48,13 @@ class Material {
   // cast caustics (renderer/caustic_tracer.h).
   virtual bool hasDeltaLobes() const { return false; }
 
+  // Whether sample() reads its direction numbers u, and its lobe number uLobe: a caller drawing
+  // the numbers of many vertices together passes over the ones a material never reads
+  // (renderer/sampler_lanes.h, RequestUse), and the sampler's later numbers stay the same. False
+  // only where sample() returns the same for any value (tests/test_materials.cpp).
+  bool usesDirectionSample() const { return usesDirection_; }
+  bool usesLobeSample() const { return usesLobe_; }
+
   // Whether any of its parameters is a texture, i.e. its hits need texture coordinates. Hits on
   // analytic shapes skip the UV (the sphere's inverse trigonometry) when the material reads none.
   virtual bool readsUv() const { return true; }
@@ -67,7 +74,8 @@ class Material {
  protected:
   // absorbsAt for a material that sets mayAbsorb_.
   virtual bool absorbsEverythingAt(const SurfaceHit& /*hit*/) const { return false; }
-  bool mayAbsorb_ = false;  // some hit may be black in every lobe
+  bool mayAbsorb_ = false;                       // some hit may be black in every lobe
+  bool usesDirection_ = true, usesLobe_ = true;  // see usesDirectionSample
 };
 
 // wo and wi on the same geometric side of the surface (a reflection, not a transmission).

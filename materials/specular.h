@@ -17,7 +17,9 @@ namespace ember {
 
 class Mirror final : public Material {
  public:
-  explicit Mirror(const Color& reflectance) : reflectance_(reflectance) {}
+  explicit Mirror(const Color& reflectance) : reflectance_(reflectance) {
+    usesDirection_ = usesLobe_ = false;  // one direction, always taken
+  }
   std::string_view typeName() const override { return "mirror"; }
   Color eval(const SurfaceHit&, const Vec3&, const Vec3&) const override { return Color(0.0f); }
   float pdf(const SurfaceHit&, const Vec3&, const Vec3&) const override { return 0.0f; }
@@ -33,7 +35,9 @@ class Mirror final : public Material {
 class Refraction final : public Material {
  public:
   Refraction(const Color& transmittance, float iorInside, float iorOutside)
-      : transmittance_(transmittance), iorInside_(iorInside), iorOutside_(iorOutside) {}
+      : transmittance_(transmittance), iorInside_(iorInside), iorOutside_(iorOutside) {
+    usesDirection_ = usesLobe_ = false;  // Snell's direction, or total internal reflection
+  }
   std::string_view typeName() const override { return "refraction"; }
   Color eval(const SurfaceHit&, const Vec3&, const Vec3&) const override { return Color(0.0f); }
   float pdf(const SurfaceHit&, const Vec3&, const Vec3&) const override { return 0.0f; }
@@ -49,7 +53,9 @@ class Refraction final : public Material {
 
 class Dielectric final : public Material {
  public:
-  Dielectric(float iorInside, float iorOutside) : iorInside_(iorInside), iorOutside_(iorOutside) {}
+  Dielectric(float iorInside, float iorOutside) : iorInside_(iorInside), iorOutside_(iorOutside) {
+    usesDirection_ = false;  // uLobe chooses reflection or refraction, each one direction
+  }
   std::string_view typeName() const override { return "dielectric"; }
   Color eval(const SurfaceHit&, const Vec3&, const Vec3&) const override { return Color(0.0f); }
   float pdf(const SurfaceHit&, const Vec3&, const Vec3&) const override { return 0.0f; }

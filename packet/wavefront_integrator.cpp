@@ -48,6 +48,7 @@ struct Wave {
   std::array<float, kSize> drawn1D;
   std::array<Vec2, kSize> drawn2D;
   std::array<uint16_t, kSize> lightVertex;
+  std::array<RequestUse, kSize> bsdfUse;  // which of its BSDF sample's numbers a vertex's material reads
   ClosestHitBatch closest{kSize};
   ShadowBatch shadows{kSize};
 };
@@ -101,6 +102,11 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
   const uint64_t pixels = uint64_t(tileWidth) * uint64_t(work.y1 - work.y0);
   const uint64_t total = pixels * uint64_t(work.spp);
   const uint64_t width = uint64_t(film.width());
+  // The light choice reads its number only among several lights, and the light's sample its two
+  // only where some light is not a point (spot, directional) light; numbers no one reads are
+  // passed over, not computed (renderer/sampler_lanes.h).
+  const LightSampler& lights = scene.lightSampler();
+  const RequestUse lightUse{lights.size() > 1, lights.deltaLightCount() < lights.size()};
 
   // Camera samples are taken sample index by sample index, each over all of the tile's pixels.
   for (uint64_t first = 0; first < total; first += Wave::kSize) {
@@ -157,13 +163,14 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
         ++vertices;
       }
       // pickLight for the bounce: its 1D, then its 2D request, then the choice.
-      draw1DThen2DLanes(wave.samplerOf.data(), lightDraws, wave.drawn1D.data(), wave.drawn2D.data());
+      draw1DThen2DLanes(wave.samplerOf.data(), lightDraws, wave.drawn1D.data(), wave.drawn2D.data(),
+                        lightUse);
       for (size_t j = 0; j < lightDraws; ++j) {
         const size_t v = wave.lightVertex[j];
         if (PathIntegrator::pickLightWith(scene, wave.drawn1D[j], wave.drawn2D[j], wave.picks[v]))
           wave.queryKey[queries++] = uint64_t(wave.picks[v].light->samplerIndex) << 16 | v;
       }
-      sampleLights(wave, queries, scene.lightSampler().size());
+      sampleLights(wave, queries, lights.size());
 
       wave.shadows.clear();
       size_t next = 0;
@@ -180,9 +187,12 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
         wave.bsdfs.hit[v] = &wave.hits[v];
         wave.bsdfs.wo[v] = -lane.path.ray.dir;
         wave.samplerOf[v] = &lane.sampler;
+        const Material& material = *wave.hits[v].material;
+        wave.bsdfUse[v] = {material.usesDirectionSample(), material.usesLobeSample()};
       }
       // PathIntegrator::drawBsdfSample for the bounce: its 2D, then its 1D request.
-      draw2DThen1DLanes(wave.samplerOf.data(), vertices, wave.bsdfs.u.data(), wave.bsdfs.uLobe.data());
+      draw2DThen1DLanes(wave.samplerOf.data(), vertices, wave.bsdfs.u.data(), wave.bsdfs.uLobe.data(),
+                        wave.bsdfUse.data());
       wave.bsdfs.sampleAll(vertices);
       wave.closest.clear();  // its hits are all read
       for (size_t v = 0; v < vertices; ++v) {

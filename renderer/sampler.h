@@ -49,6 +49,25 @@ class Sampler {
             toFloat(reverseBits(laineKarras(sobolSecondReversed(i), seed * 0x85ebca6bu)))};
   }
 
+  // Pass over the next 1D or 2D request as get1D / get2D would, without computing its value: a
+  // request whose number nobody reads (renderer/sampler_lanes.h). Every later request then
+  // returns exactly what it would after the full draw: a Sobol request only moves to the next
+  // dimension, and a PCG32 one takes the same steps of the stream (one per number).
+  void skip1D() {
+    if (nextIsSobol())
+      ++dimension_;
+    else
+      rng_.nextU32();
+  }
+  void skip2D() {
+    if (nextIsSobol()) {
+      ++dimension_;
+    } else {
+      rng_.nextU32();
+      rng_.nextU32();
+    }
+  }
+
   // Dimensions (1D or 2D requests) drawn from the Sobol sequence before the PCG32 stream takes
   // over: the camera jitter, the first bounce and the second bounce's light sample, where
   // stratification pays. Measured (docs/performance.md): 8 keeps the error of 64 within noise on

@@ -166,19 +166,43 @@ void draw2DLanes(Sampler* const* samplers, size_t n, Vec2* out) {
   for (size_t i = 0; i < n; ++i) requests.request(*samplers[i], true, &out[i].x, &out[i].y);
 }
 
-void draw1DThen2DLanes(Sampler* const* samplers, size_t n, float* first, Vec2* second) {
+void draw1DThen2DLanes(Sampler* const* samplers, size_t n, float* first, Vec2* second, RequestUse use) {
   SobolRequests requests;
   for (size_t i = 0; i < n; ++i) {
-    requests.request(*samplers[i], false, &first[i], nullptr);
-    requests.request(*samplers[i], true, &second[i].x, &second[i].y);
+    Sampler& s = *samplers[i];
+    if (use.first) {
+      requests.request(s, false, &first[i], nullptr);
+    } else {
+      s.skip1D();
+      first[i] = 0.5f;
+    }
+    if (use.second) {
+      requests.request(s, true, &second[i].x, &second[i].y);
+    } else {
+      s.skip2D();
+      second[i] = Vec2(0.5f);
+    }
   }
 }
 
-void draw2DThen1DLanes(Sampler* const* samplers, size_t n, Vec2* first, float* second) {
+void draw2DThen1DLanes(Sampler* const* samplers, size_t n, Vec2* first, float* second,
+                       const RequestUse* use) {
   SobolRequests requests;
   for (size_t i = 0; i < n; ++i) {
-    requests.request(*samplers[i], true, &first[i].x, &first[i].y);
-    requests.request(*samplers[i], false, &second[i], nullptr);
+    Sampler& s = *samplers[i];
+    const RequestUse u = use ? use[i] : RequestUse{};
+    if (u.first) {
+      requests.request(s, true, &first[i].x, &first[i].y);
+    } else {
+      s.skip2D();
+      first[i] = Vec2(0.5f);
+    }
+    if (u.second) {
+      requests.request(s, false, &second[i], nullptr);
+    } else {
+      s.skip1D();
+      second[i] = 0.5f;
+    }
   }
 }
 

@@ -31,9 +31,19 @@ struct SobolBlock {
 void draw1DLanes(Sampler* const* samplers, size_t n, float* out);
 // out[i] = samplers[i]->get2D() for i < n.
 void draw2DLanes(Sampler* const* samplers, size_t n, Vec2* out);
+// Which of a step's two requests its caller reads. One that is not read is passed over
+// (Sampler::skip1D / skip2D) instead of computed, and its output set to 0.5: the sampler's state
+// afterwards, and so every later number, is what the full draw leaves (tests/test_sampling_lanes.cpp).
+// A light choice among one light reads no number, nor a point light's sample; a Lambertian
+// reflection reads no lobe number, a mirror neither of its two (Material::usesDirectionSample).
+struct RequestUse {
+  bool first = true, second = true;
+};
 // Two requests of each sampler in one pass (a light choice's, a BSDF sample's): first[i] =
-// samplers[i]->get1D(), then second[i] = samplers[i]->get2D(); and the other way round.
-void draw1DThen2DLanes(Sampler* const* samplers, size_t n, float* first, Vec2* second);
-void draw2DThen1DLanes(Sampler* const* samplers, size_t n, Vec2* first, float* second);
+// samplers[i]->get1D(), then second[i] = samplers[i]->get2D(); and the other way round. `use`:
+// the same for every sampler, or one per sampler (nullptr: every request is read).
+void draw1DThen2DLanes(Sampler* const* samplers, size_t n, float* first, Vec2* second, RequestUse use = {});
+void draw2DThen1DLanes(Sampler* const* samplers, size_t n, Vec2* first, float* second,
+                       const RequestUse* use = nullptr);
 
 }  // namespace ember

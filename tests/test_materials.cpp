@@ -15,6 +15,7 @@
 #include "core/rng.h"
 #include "core/sampling.h"
 #include "materials/fresnel.h"
+#include "materials/gltf_pbr.h"
 #include "materials/lambertian.h"
 #include "materials/mixed.h"
 #include "materials/phong.h"
@@ -25,6 +26,8 @@
 
 #include "mc_mean.h"
 
+#include <array>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -120,6 +123,41 @@ std::vector<MaterialCase> materialCases() {
       {"dielectric", std::make_shared<Dielectric>(kIor, 1.0f)},
       {"mixed", std::make_shared<Mixed>(mixedCoefficients())},
   };
+}
+
+// Material::usesDirectionSample and usesLobeSample may be false only where sample() returns the
+// same for any value of those numbers: the wavefront passes over numbers a material does not read
+// and hands it 0.5 instead (renderer/sampler_lanes.h). Bit for bit, for every material.
+TEST(MaterialSampling, NumbersAMaterialDoesNotReadChangeNoSample) {
+  const auto bits = [](const Vec3& v) {
+    return std::array{std::bit_cast<uint32_t>(v.x), std::bit_cast<uint32_t>(v.y),
+                      std::bit_cast<uint32_t>(v.z)};
+  };
+  Rng rng(5, 17);
+  std::vector<MaterialCase> cases = materialCases();
+  cases.push_back({"gltf", std::make_shared<GltfPbrMaterial>(GltfPbrInputs{})});
+  for (const MaterialCase& c : cases) {
+    const Material& m = *c.material;
+    for (int i = 0; i < 2000; ++i) {
+      SurfaceHit hit;
+      hit.ng = hit.ns = Vec3(0.0f, 0.0f, 1.0f);
+      hit.material = &m;
+      const Vec3 wo = sampleUniformSphere(next2(rng));
+      const Vec2 u = next2(rng);
+      const float uLobe = rng.uniform();
+      // The numbers the material claims not to read replaced by others.
+      const Vec2 otherU = m.usesDirectionSample() ? u : next2(rng);
+      const float otherLobe = m.usesLobeSample() ? uLobe : rng.uniform();
+      BsdfSample a, b;
+      const bool okA = m.sample(hit, wo, u, uLobe, a), okB = m.sample(hit, wo, otherU, otherLobe, b);
+      ASSERT_EQ(okA, okB) << c.name << " sample " << i;
+      if (!okA) continue;
+      ASSERT_EQ(bits(a.wi), bits(b.wi)) << c.name << " sample " << i;
+      ASSERT_EQ(bits(a.weight), bits(b.weight)) << c.name << " sample " << i;
+      ASSERT_EQ(std::bit_cast<uint32_t>(a.pdf), std::bit_cast<uint32_t>(b.pdf)) << c.name << " sample " << i;
+      ASSERT_EQ(a.delta, b.delta) << c.name << " sample " << i;
+    }
+  }
 }
 
 // Energy carried by one sample: the weight with refraction's radiance scaling 1 / eta^2 removed

@@ -500,6 +500,34 @@ void expectSamplerLanesEqualTheScalarSampler() {
           EXPECT_EQ(reference[i].get1D(), out[i]) << "request " << request << " lane " << i;
       }
     }
+    // Requests no one reads (RequestUse) are passed over: the read ones equal the scalar draws,
+    // the others are 0.5, and the samplers' later numbers are what the full draws leave. The
+    // rounds pass every sampler through its last Sobol dimensions into its PCG32 stream.
+    const size_t n = lanes.size();
+    for (int round = 0; round < 12; ++round) {
+      std::vector<float> one(n);
+      std::vector<Vec2> two(n);
+      std::vector<RequestUse> use(n);
+      for (size_t i = 0; i < n; ++i)
+        use[i] = {(i + size_t(round)) % 2 == 0, (i / 2 + size_t(round)) % 2 == 0};
+      const bool oneFirst = round % 2 == 0;
+      const RequestUse uniform = use[size_t(round) % 4];  // the same for every sampler
+      if (oneFirst)
+        draw1DThen2DLanes(pointers.data(), n, one.data(), two.data(), uniform);
+      else
+        draw2DThen1DLanes(pointers.data(), n, two.data(), one.data(), use.data());
+      for (size_t i = 0; i < n; ++i) {
+        const RequestUse u = oneFirst ? uniform : use[i];
+        const bool readsOne = oneFirst ? u.first : u.second, readsTwo = oneFirst ? u.second : u.first;
+        float expectedOne = 0.0f;
+        if (oneFirst) expectedOne = reference[i].get1D();
+        const Vec2 expectedTwo = reference[i].get2D();
+        if (!oneFirst) expectedOne = reference[i].get1D();
+        EXPECT_EQ(readsOne ? expectedOne : 0.5f, one[i]) << "round " << round << " lane " << i;
+        EXPECT_EQ(readsTwo ? expectedTwo.x : 0.5f, two[i].x) << "round " << round << " lane " << i;
+        EXPECT_EQ(readsTwo ? expectedTwo.y : 0.5f, two[i].y) << "round " << round << " lane " << i;
+      }
+    }
   }
 }
 
