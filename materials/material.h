@@ -48,10 +48,10 @@ class Material {
   // cast caustics (renderer/caustic_tracer.h).
   virtual bool hasDeltaLobes() const { return false; }
 
-  // Whether sample() reads its direction numbers u, and its lobe number uLobe: a caller drawing
-  // the numbers of many vertices together passes over the ones a material never reads
-  // (renderer/sampler_lanes.h, RequestUse), and the sampler's later numbers stay the same. False
-  // only where sample() returns the same for any value (tests/test_materials.cpp).
+  // Whether sample() and sampleLanes read the direction numbers u, and the lobe number uLobe: a
+  // caller drawing the numbers of many vertices together passes over the ones a material never
+  // reads (renderer/sampler_lanes.h, RequestUse), and the sampler's later numbers stay the same.
+  // False only where both return the same for any value (tests/test_materials.cpp).
   bool usesDirectionSample() const { return usesDirection_; }
   bool usesLobeSample() const { return usesLobe_; }
 

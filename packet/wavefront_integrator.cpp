@@ -103,7 +103,7 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
   const uint64_t total = pixels * uint64_t(work.spp);
   const uint64_t width = uint64_t(film.width());
   // The light choice reads its number only among several lights, and the light's sample its two
-  // only where some light is not a point (spot, directional) light; numbers no one reads are
+  // only where some light is not a point, spot or directional light; numbers no one reads are
   // passed over, not computed (renderer/sampler_lanes.h).
   const LightSampler& lights = scene.lightSampler();
   const RequestUse lightUse{lights.size() > 1, lights.deltaLightCount() < lights.size()};

@@ -34,8 +34,9 @@ void draw2DLanes(Sampler* const* samplers, size_t n, Vec2* out);
 // Which of a step's two requests its caller reads. One that is not read is passed over
 // (Sampler::skip1D / skip2D) instead of computed, and its output set to 0.5: the sampler's state
 // afterwards, and so every later number, is what the full draw leaves (tests/test_sampling_lanes.cpp).
-// A light choice among one light reads no number, nor a point light's sample; a Lambertian
-// reflection reads no lobe number, a mirror neither of its two (Material::usesDirectionSample).
+// A light choice among one light reads no number, and in a scene whose lights are all point, spot
+// or directional lights no light sample reads its two; a Lambertian reflection reads no lobe
+// number, a mirror neither of its two (Material::usesDirectionSample).
 struct RequestUse {
   bool first = true, second = true;
 };

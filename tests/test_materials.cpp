@@ -126,8 +126,9 @@ std::vector<MaterialCase> materialCases() {
 }
 
 // Material::usesDirectionSample and usesLobeSample may be false only where sample() returns the
-// same for any value of those numbers: the wavefront passes over numbers a material does not read
-// and hands it 0.5 instead (renderer/sampler_lanes.h). Bit for bit, for every material.
+// same for any value of those numbers, and so does sampleLanes: the wavefront passes over numbers
+// a material does not read and hands it 0.5 instead (renderer/sampler_lanes.h). Bit for bit, for
+// every material.
 TEST(MaterialSampling, NumbersAMaterialDoesNotReadChangeNoSample) {
   const auto bits = [](const Vec3& v) {
     return std::array{std::bit_cast<uint32_t>(v.x), std::bit_cast<uint32_t>(v.y),
@@ -141,6 +142,7 @@ TEST(MaterialSampling, NumbersAMaterialDoesNotReadChangeNoSample) {
     for (int i = 0; i < 2000; ++i) {
       SurfaceHit hit;
       hit.ng = hit.ns = Vec3(0.0f, 0.0f, 1.0f);
+      hit.uv = next2(rng);
       hit.material = &m;
       const Vec3 wo = sampleUniformSphere(next2(rng));
       const Vec2 u = next2(rng);
@@ -156,6 +158,37 @@ TEST(MaterialSampling, NumbersAMaterialDoesNotReadChangeNoSample) {
       ASSERT_EQ(bits(a.weight), bits(b.weight)) << c.name << " sample " << i;
       ASSERT_EQ(std::bit_cast<uint32_t>(a.pdf), std::bit_cast<uint32_t>(b.pdf)) << c.name << " sample " << i;
       ASSERT_EQ(a.delta, b.delta) << c.name << " sample " << i;
+      ASSERT_EQ(std::bit_cast<uint32_t>(a.eta), std::bit_cast<uint32_t>(b.eta)) << c.name << " sample " << i;
+    }
+    // sampleLanes, which the wavefront calls, over a run of vertices with the same replacements.
+    constexpr size_t kRun = 37;  // more than two blocks of the cosine kernel's lanes
+    std::vector<SurfaceHit> hits(kRun);
+    std::vector<const SurfaceHit*> hitPointers;
+    std::vector<Vec3> wo(kRun);
+    std::vector<Vec2> u(kRun), otherU(kRun);
+    std::vector<float> uLobe(kRun), otherLobe(kRun);
+    for (size_t i = 0; i < kRun; ++i) {
+      hits[i].ng = hits[i].ns = Vec3(0.0f, 0.0f, 1.0f);
+      hits[i].uv = next2(rng);
+      hits[i].material = &m;
+      hitPointers.push_back(&hits[i]);
+      wo[i] = sampleUniformSphere(next2(rng));
+      u[i] = next2(rng);
+      uLobe[i] = rng.uniform();
+      otherU[i] = m.usesDirectionSample() ? u[i] : next2(rng);
+      otherLobe[i] = m.usesLobeSample() ? uLobe[i] : rng.uniform();
+    }
+    std::vector<BsdfSample> a(kRun), b(kRun);
+    std::unique_ptr<bool[]> okA(new bool[kRun]), okB(new bool[kRun]);
+    m.sampleLanes(hitPointers.data(), wo.data(), u.data(), uLobe.data(), kRun, a.data(), okA.get());
+    m.sampleLanes(hitPointers.data(), wo.data(), otherU.data(), otherLobe.data(), kRun, b.data(), okB.get());
+    for (size_t i = 0; i < kRun; ++i) {
+      ASSERT_EQ(okA[i], okB[i]) << c.name << " lane " << i;
+      if (!okA[i]) continue;
+      ASSERT_EQ(bits(a[i].wi), bits(b[i].wi)) << c.name << " lane " << i;
+      ASSERT_EQ(bits(a[i].weight), bits(b[i].weight)) << c.name << " lane " << i;
+      ASSERT_EQ(std::bit_cast<uint32_t>(a[i].pdf), std::bit_cast<uint32_t>(b[i].pdf))
+          << c.name << " lane " << i;
     }
   }
 }

@@ -462,6 +462,7 @@ void expectSamplerLanesEqualTheScalarSampler() {
         reference.back().get1D();
       }
     }
+    const std::vector<Sampler> initial = lanes;  // for the skipped requests below
     std::vector<Sampler*> pointers;
     for (Sampler& s : lanes) pointers.push_back(&s);
     for (int request = 0; request < 16; ++request) {
@@ -502,7 +503,11 @@ void expectSamplerLanesEqualTheScalarSampler() {
     }
     // Requests no one reads (RequestUse) are passed over: the read ones equal the scalar draws,
     // the others are 0.5, and the samplers' later numbers are what the full draws leave. The
-    // rounds pass every sampler through its last Sobol dimensions into its PCG32 stream.
+    // samplers start afresh (at dimensions 0 to 10), so that the rounds take each one that starts
+    // below kMaxSobolDimensions through its last Sobol dimensions into its PCG32 stream.
+    lanes = initial;
+    reference = initial;
+    for (size_t i = 0; i < lanes.size(); ++i) pointers[i] = &lanes[i];
     const size_t n = lanes.size();
     for (int round = 0; round < 12; ++round) {
       std::vector<float> one(n);
