@@ -110,8 +110,19 @@ class SobolRequests {
  public:
   ~SobolRequests() { flush(); }
 
-  // The sampler's next request into x (and y for a 2D one).
-  void request(Sampler& s, bool twoD, float* x, float* y) {
+  // The sampler's next request into x (and y for a 2D one). One its caller does not `read` is
+  // passed over (RequestUse), and its output set to 0.5.
+  void request(Sampler& s, bool twoD, float* x, float* y, bool read = true) {
+    if (!read) {
+      if (twoD) {
+        s.skip2D();
+        *y = 0.5f;
+      } else {
+        s.skip1D();
+      }
+      *x = 0.5f;
+      return;
+    }
     if (!s.nextIsSobol()) {
       if (twoD) {
         const Vec2 v = s.get2D();
@@ -169,19 +180,8 @@ void draw2DLanes(Sampler* const* samplers, size_t n, Vec2* out) {
 void draw1DThen2DLanes(Sampler* const* samplers, size_t n, float* first, Vec2* second, RequestUse use) {
   SobolRequests requests;
   for (size_t i = 0; i < n; ++i) {
-    Sampler& s = *samplers[i];
-    if (use.first) {
-      requests.request(s, false, &first[i], nullptr);
-    } else {
-      s.skip1D();
-      first[i] = 0.5f;
-    }
-    if (use.second) {
-      requests.request(s, true, &second[i].x, &second[i].y);
-    } else {
-      s.skip2D();
-      second[i] = Vec2(0.5f);
-    }
+    requests.request(*samplers[i], false, &first[i], nullptr, use.first);
+    requests.request(*samplers[i], true, &second[i].x, &second[i].y, use.second);
   }
 }
 
@@ -189,20 +189,9 @@ void draw2DThen1DLanes(Sampler* const* samplers, size_t n, Vec2* first, float* s
                        const RequestUse* use) {
   SobolRequests requests;
   for (size_t i = 0; i < n; ++i) {
-    Sampler& s = *samplers[i];
     const RequestUse u = use ? use[i] : RequestUse{};
-    if (u.first) {
-      requests.request(s, true, &first[i].x, &first[i].y);
-    } else {
-      s.skip2D();
-      first[i] = Vec2(0.5f);
-    }
-    if (u.second) {
-      requests.request(s, false, &second[i], nullptr);
-    } else {
-      s.skip1D();
-      second[i] = 0.5f;
-    }
+    requests.request(*samplers[i], true, &first[i].x, &first[i].y, u.first);
+    requests.request(*samplers[i], false, &second[i], nullptr, u.second);
   }
 }
 
