@@ -10,9 +10,6 @@ HWY_BEFORE_NAMESPACE();
 namespace ember::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-// Eight lanes: Embree's packets on AVX2 are 8 rays, and a 16-ray packet takes two steps.
-using D = hn::CappedTag<float, 8>;
-
 // Lane i of each array is the hit field of the block's lane i.
 struct HitFields {
   float* ng[3];
@@ -23,6 +20,49 @@ struct HitFields {
   uint32_t* instID;
 };
 
+// A field of the block's hits, lanes [i, i + Lanes(d)). The double-precision kernels (the
+// sphere's, the rectangles') store each block of doubles as floats, half a float vector at a
+// time; a load of the whole vector would span two stores and wait for both to retire instead of
+// taking its data from them, so a 16-lane vector is loaded as the two halves it was stored as.
+template <class D, class T>
+hn::Vec<D> loadHitField(D d, const T* p) {
+#if HWY_TARGET != HWY_SCALAR
+  if constexpr (hn::MaxLanes(D()) == 16) {
+    const hn::Half<D> half;
+    return hn::Combine(d, hn::LoadU(half, p + hn::Lanes(half)), hn::LoadU(half, p));
+  }
+#endif
+  return hn::LoadU(d, p);
+}
+
+// Commits lanes [i, i + Lanes(d)) of the block, as the scalar rule below decides each. tfar and
+// geomID are read back as whole vectors (by Embree, and by the next shape's commit), so they are
+// stored whole; the other fields, read one lane at a time after the trace, with masked stores.
+template <class D>
+void commitVector(D d, unsigned i, const LaneHits& hits, float* tfar, const HitFields& out, uint32_t primID,
+                  uint32_t geomID, uint32_t instID) {
+  const hn::RebindToUnsigned<D> du;
+  const uint8_t bits[8] = {uint8_t(hits.mask >> i), uint8_t(hits.mask >> (i + 8))};  // may read 8 bytes
+  const auto has = hn::LoadMaskBits(d, bits);
+  if (hn::AllFalse(d, has)) return;
+  const auto t = loadHitField(d, hits.t + i), current = hn::LoadU(d, tfar + i);
+  const auto currentGeometry = hn::LoadU(du, out.geomID + i);
+  const auto ours = hn::Set(du, geomID);
+  const auto beatsTie =
+      hn::RebindMask(d, hn::And(hn::Ne(currentGeometry, hn::Set(du, uint32_t(RTC_INVALID_GEOMETRY_ID))),
+                                hn::Gt(currentGeometry, ours)));
+  const auto keep = hn::And(has, hn::And(hn::Le(t, current), hn::Or(hn::Ne(t, current), beatsTie)));
+  if (hn::AllFalse(d, keep)) return;
+  const auto keepU = hn::RebindMask(du, keep);
+  hn::StoreU(hn::IfThenElse(keep, t, current), d, tfar + i);
+  hn::StoreU(hn::IfThenElse(keepU, ours, currentGeometry), du, out.geomID + i);
+  for (int c = 0; c < 3; ++c) hn::BlendedStore(loadHitField(d, hits.ng[c] + i), keep, d, out.ng[c] + i);
+  hn::BlendedStore(loadHitField(d, hits.uv[0] + i), keep, d, out.u + i);
+  hn::BlendedStore(loadHitField(d, hits.uv[1] + i), keep, d, out.v + i);
+  hn::BlendedStore(hn::Set(du, primID), keepU, du, out.primID + i);
+  hn::BlendedStore(hn::Set(du, instID), keepU, du, out.instID + i);
+}
+
 void CommitLaneHits(const LaneHits& hits, unsigned n, float* tfar, RTCHitN* packet, unsigned width,
                     unsigned first, uint32_t primID, uint32_t geomID, uint32_t instID) {
   const HitFields out{{&RTCHitN_Ng_x(packet, width, first), &RTCHitN_Ng_y(packet, width, first),
@@ -32,41 +72,26 @@ void CommitLaneHits(const LaneHits& hits, unsigned n, float* tfar, RTCHitN* pack
                       &RTCHitN_primID(packet, width, first),
                       &RTCHitN_geomID(packet, width, first),
                       &RTCHitN_instID(packet, width, first, 0)};
-  const uint32_t kNoGeometry = RTC_INVALID_GEOMETRY_ID;
-  const D d;
-  const hn::RebindToUnsigned<D> du;
-  const unsigned step = unsigned(hn::Lanes(d));
-  const auto none = hn::Set(du, kNoGeometry), ours = hn::Set(du, geomID);
-  const auto prim = hn::Set(du, primID), inst = hn::Set(du, instID);
+  // The widest vectors first: a 16-ray packet in one step where the CPU has 16 float lanes.
+  // Embree and the next shape's callback read tfar (and the hit fields) back as whole vectors,
+  // and a load spanning two narrower stores cannot take its data from them (store-to-load
+  // forwarding): with two 8-lane steps, the next callback's first load of tfar waited for both
+  // stores to retire (`perf annotate`: 83% of the tfar pass's samples on a 16-lane packet).
+  const hn::CappedTag<float, 16> wide;
+  const hn::CappedTag<float, 8> narrow;
   unsigned i = 0;
-  for (; i + step <= n; i += step) {
-    const uint8_t bits[8] = {uint8_t(hits.mask >> i)};  // LoadMaskBits may read 8 bytes
-    const auto has = hn::LoadMaskBits(d, bits);
-    if (hn::AllFalse(d, has)) continue;
-    const auto t = hn::LoadU(d, hits.t + i), current = hn::LoadU(d, tfar + i);
-    const auto currentGeometry = hn::LoadU(du, out.geomID + i);
-    const auto beatsTie =
-        hn::RebindMask(d, hn::And(hn::Ne(currentGeometry, none), hn::Gt(currentGeometry, ours)));
-    const auto keep = hn::And(has, hn::And(hn::Le(t, current), hn::Or(hn::Ne(t, current), beatsTie)));
-    if (hn::AllFalse(d, keep)) continue;
-    const auto keepU = hn::RebindMask(du, keep);
-    hn::StoreU(hn::IfThenElse(keep, t, current), d, tfar + i);
-    for (int c = 0; c < 3; ++c)
-      hn::StoreU(hn::IfThenElse(keep, hn::LoadU(d, hits.ng[c] + i), hn::LoadU(d, out.ng[c] + i)), d,
-                 out.ng[c] + i);
-    hn::StoreU(hn::IfThenElse(keep, hn::LoadU(d, hits.uv[0] + i), hn::LoadU(d, out.u + i)), d, out.u + i);
-    hn::StoreU(hn::IfThenElse(keep, hn::LoadU(d, hits.uv[1] + i), hn::LoadU(d, out.v + i)), d, out.v + i);
-    hn::StoreU(hn::IfThenElse(keepU, prim, hn::LoadU(du, out.primID + i)), du, out.primID + i);
-    hn::StoreU(hn::IfThenElse(keepU, ours, currentGeometry), du, out.geomID + i);
-    hn::StoreU(hn::IfThenElse(keepU, inst, hn::LoadU(du, out.instID + i)), du, out.instID + i);
-  }
+  for (; i + hn::Lanes(wide) <= n; i += unsigned(hn::Lanes(wide)))
+    commitVector(wide, i, hits, tfar, out, primID, geomID, instID);
+  for (; i + hn::Lanes(narrow) <= n; i += unsigned(hn::Lanes(narrow)))
+    commitVector(narrow, i, hits, tfar, out, primID, geomID, instID);
   // The lanes past the last whole vector (a single ray, or a padded block), one by one.
   for (uint32_t bits = hits.mask & ~((1u << i) - 1u); bits != 0; bits &= bits - 1) {
     const unsigned lane = unsigned(__builtin_ctz(bits));
     if (lane >= n) break;
     const float t = hits.t[lane];
     if (!(t <= tfar[lane])) continue;
-    if (t == tfar[lane] && (out.geomID[lane] == kNoGeometry || out.geomID[lane] <= geomID)) continue;
+    if (t == tfar[lane] && (out.geomID[lane] == RTC_INVALID_GEOMETRY_ID || out.geomID[lane] <= geomID))
+      continue;
     tfar[lane] = t;
     for (int c = 0; c < 3; ++c) out.ng[c][lane] = hits.ng[c][lane];
     out.u[lane] = hits.uv[0][lane];
