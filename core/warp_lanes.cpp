@@ -12,14 +12,14 @@ HWY_BEFORE_NAMESPACE();
 namespace ember::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-using D = hn::CappedTag<float, CosineLanes::kMaxLanes>;
+using D = hn::CappedTag<float, CosineLanes::kGroup>;
 using V = hn::Vec<D>;
 using M = hn::Mask<D>;
 
-void SampleCosineLanes(CosineLanes& lanes) {
+void SampleCosineLanes(CosineLanes& lanes, unsigned count) {
   const D d;
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0f), quarterPi = hn::Set(d, 0.25f * kPi);
-  for (unsigned i = 0; i < CosineLanes::kMaxLanes; i += unsigned(hn::Lanes(d))) {
+  for (unsigned i = 0; i < count; i += unsigned(hn::Lanes(d))) {
     // The concentric map: the square's point (ox, oy) onto the disc's radius r and angle theta.
     const V ox = hn::Sub(hn::Add(hn::Load(d, lanes.u[0] + i), hn::Load(d, lanes.u[0] + i)), one);
     const V oy = hn::Sub(hn::Add(hn::Load(d, lanes.u[1] + i), hn::Load(d, lanes.u[1] + i)), one);
@@ -59,8 +59,8 @@ namespace ember {
 
 HWY_EXPORT(SampleCosineLanes);
 
-void sampleCosineLanes(CosineLanes& lanes) {
-  HWY_DYNAMIC_DISPATCH(SampleCosineLanes)(lanes);
+void sampleCosineLanes(CosineLanes& lanes, unsigned count) {
+  HWY_DYNAMIC_DISPATCH(SampleCosineLanes)(lanes, count);
 }
 
 }  // namespace ember

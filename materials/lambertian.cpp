@@ -34,8 +34,7 @@ Color Lambertian::evalPdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi,
 bool Lambertian::sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float, BsdfSample& out) const {
   CosineLanes lanes;
   lanes.set(0, facingNormal(hit, wo), u);
-  lanes.padFrom(1);
-  sampleCosineLanes(lanes);
+  sampleCosineLanes(lanes, lanes.padFrom(1));
   return finishSample(hit, wo, lanes.direction(0), lanes.pdf[0], out);
 }
 
@@ -46,8 +45,7 @@ void Lambertian::sampleLanes(const SurfaceHit* const* hits, const Vec3* wo, cons
     const unsigned count = unsigned(std::min<size_t>(CosineLanes::kMaxLanes, n - first));
     for (unsigned i = 0; i < count; ++i)
       lanes.set(i, facingNormal(*hits[first + i], wo[first + i]), u[first + i]);
-    lanes.padFrom(count);
-    sampleCosineLanes(lanes);
+    sampleCosineLanes(lanes, lanes.padFrom(count));
     for (unsigned i = 0; i < count; ++i)
       ok[first + i] =
           finishSample(*hits[first + i], wo[first + i], lanes.direction(i), lanes.pdf[i], out[first + i]);
