@@ -73,12 +73,9 @@ struct LaneHits {
   }
   // Every lane's normal n, and texture coordinates (0, 0): a flat shape's hits, before their t
   // (and, where wanted, uv) are written.
-  void fillFlat(const Vec3& n) {
-    for (unsigned i = 0; i < kLanes; ++i) {
-      ng[0][i] = n.x, ng[1][i] = n.y, ng[2][i] = n.z;
-      uv[0][i] = uv[1][i] = 0.0f;
-    }
-  }
+  // With whole-vector stores (a Highway kernel): the callback's commit reads these arrays back
+  // as vectors at once, and a load spanning several narrower stores would wait for them to retire.
+  void fillFlat(const Vec3& n);
 };
 
 // A triangle (v0, v1, v2) as its float filter sees it: the plane dot(n, x) = d, and the dual
