@@ -15,15 +15,34 @@ void GeometryGroups::group(const ClosestHitBatch& batch, size_t active, size_t g
     for (size_t o = 0; o < active; ++o) order_[o] = uint16_t(sortKey_[o] & 0xffffu);
     return;
   }
-  if (start_.size() < buckets + 1) start_.assign(buckets + 1, 0);
-  std::fill(start_.begin(), start_.begin() + ptrdiff_t(buckets + 1), uint16_t(0));
-  for (size_t a = 0; a < active; ++a) {
-    const uint32_t key = batch.geometryOf(a) + 1u;  // RTC_INVALID_GEOMETRY_ID + 1 == 0
-    key_[a] = key;
-    ++start_[key + 1];
-  }
-  for (size_t b = 1; b <= buckets; ++b) start_[b] += start_[b - 1];
-  for (size_t a = 0; a < active; ++a) order_[start_[key_[a]]++] = uint16_t(a);
+  // kWays counting sorts' counters, one per consecutive range of the batch, visited in turn: most
+  // of a bounce's hits fall in a few buckets, and the increments of one counter in consecutive
+  // steps would each wait for the last through memory (store to load). Bucket by bucket, the
+  // ranges' slots follow one another in range order, so the order is the one counter's (stable).
+  const size_t range = (active + kWays - 1) / kWays;
+  if (start_.size() < kWays * buckets) start_.assign(kWays * buckets, 0);
+  std::fill(start_.begin(), start_.begin() + ptrdiff_t(kWays * buckets), uint16_t(0));
+  for (size_t i = 0; i < range; ++i)
+    for (size_t w = 0; w < kWays; ++w) {
+      const size_t a = w * range + i;
+      if (a >= active) break;
+      const uint32_t key = batch.geometryOf(a) + 1u;  // RTC_INVALID_GEOMETRY_ID + 1 == 0
+      key_[a] = key;
+      ++start_[w * buckets + key];
+    }
+  uint16_t next = 0;
+  for (size_t b = 0; b < buckets; ++b)
+    for (size_t w = 0; w < kWays; ++w) {
+      const uint16_t count = start_[w * buckets + b];
+      start_[w * buckets + b] = next;
+      next = uint16_t(next + count);
+    }
+  for (size_t i = 0; i < range; ++i)
+    for (size_t w = 0; w < kWays; ++w) {
+      const size_t a = w * range + i;
+      if (a >= active) break;
+      order_[start_[w * buckets + key_[a]]++] = uint16_t(a);
+    }
 }
 
 }  // namespace ember

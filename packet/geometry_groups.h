@@ -28,7 +28,8 @@ class GeometryGroups {
   std::array<uint16_t, kMaxLanes> order_;
   std::array<uint32_t, kMaxLanes> key_;      // geomID + 1 of each batch index's hit, 0 for a miss
   std::array<uint64_t, kMaxLanes> sortKey_;  // (geomID + 1) << 16 | batch index, for many geometries
-  std::vector<uint16_t> start_;              // counting-sort buckets, sized once per scene
+  static constexpr size_t kWays = 4;         // counters per bucket (geometry_groups.cpp)
+  std::vector<uint16_t> start_;  // counting-sort buckets, kWays per geometry, sized once per scene
 };
 
 }  // namespace ember
