@@ -154,11 +154,36 @@ uint32_t BoxCrossingsKernel(const RayLanes& rays, const ExactBox& box, uint32_t 
   return hits;
 }
 
+// The texture coordinates of a block's crossings (Quad::rectangleUv and parallelogramUv, operation
+// for operation in float after the double division, so that each lane equals the scalar code).
+HWY_INLINE void rectangleUvLanes(V64 a, V64 b, const ExactAxisRectangle& rect, const Vec2* uv, float* u,
+                                 float* v, unsigned i) {
+  const D64 d;
+  const hn::Rebind<float, D64> df;
+  const auto s = hn::DemoteTo(df, hn::Div(hn::Sub(a, hn::Set(d, rect.corner[0])), hn::Set(d, rect.edge[0])));
+  const auto r = hn::DemoteTo(df, hn::Div(hn::Sub(b, hn::Set(d, rect.corner[1])), hn::Set(d, rect.edge[1])));
+  // (s, r) along v1 - v0 and v3 - v0: the half (v0, v1, v2) where s >= r, with barycentrics
+  // (s - r, r); the other (v0, v2, v3) with (s, r - s). Then uvAt: (1 - b1 - b2) uv0 + b1 uvA + b2 uvB.
+  const auto first = hn::Ge(s, r);
+  const auto b1 = hn::IfThenElse(first, hn::Sub(s, r), s);
+  const auto b2 = hn::IfThenElse(first, r, hn::Sub(r, s));
+  const auto w0 = hn::Sub(hn::Sub(hn::Set(df, 1.0f), b1), b2);
+  float* const outs[2] = {u, v};
+  for (int c = 0; c < 2; ++c) {
+    const auto uvA = hn::IfThenElse(first, hn::Set(df, uv[1][c]), hn::Set(df, uv[2][c]));
+    const auto uvB = hn::IfThenElse(first, hn::Set(df, uv[2][c]), hn::Set(df, uv[3][c]));
+    const auto sum = hn::Add(hn::Add(hn::Mul(w0, hn::Set(df, uv[0][c])), hn::Mul(b1, uvA)), hn::Mul(b2, uvB));
+    hn::StoreU(sum, df, outs[c] + i);
+  }
+}
+
 // The rectangle's test for every lane of `rays`: live where `lanes` has a bit (kLiveFromValid:
-// where the ray is valid), with each lane's t also rounded to float into tFloat when given.
+// where the ray is valid), with each lane's t also rounded to float into tFloat when given, and
+// with uvCorners its texture coordinates into u and v.
 template <bool kLiveFromValid>
 HWY_INLINE uint32_t axisRectangleLanes(const RayLanes& rays, const ExactAxisRectangle& rect, uint32_t lanes,
-                                       RectangleLanes& out, float* tFloat) {
+                                       RectangleLanes& out, float* tFloat, const Vec2* uvCorners = nullptr,
+                                       float* u = nullptr, float* v = nullptr) {
   const D64 d;
   const hn::Rebind<float, D64> df;
   const unsigned step = unsigned(hn::Lanes(d));
@@ -183,6 +208,7 @@ HWY_INLINE uint32_t axisRectangleLanes(const RayLanes& rays, const ExactAxisRect
     hn::StoreU(a, d, out.a + i);
     hn::StoreU(b, d, out.b + i);
     if (tFloat) hn::StoreU(hn::DemoteTo(df, tHit), df, tFloat + i);
+    if (uvCorners) rectangleUvLanes(a, b, rect, uvCorners, u, v, i);
     hits |= blockBits(d, hit, i);
   }
   return hits;
@@ -194,8 +220,8 @@ uint32_t AxisRectangleCrossingsKernel(const RayLanes& rays, const ExactAxisRecta
 }
 
 uint32_t AxisRectangleHitsKernel(const RayLanes& rays, const ExactAxisRectangle& rect, RectangleLanes& out,
-                                 float* t) {
-  return axisRectangleLanes<true>(rays, rect, 0, out, t);
+                                 float* t, const Vec2* uvCorners, float* u, float* v) {
+  return axisRectangleLanes<true>(rays, rect, 0, out, t, uvCorners, u, v);
 }
 
 }  // namespace ember::HWY_NAMESPACE
@@ -357,8 +383,8 @@ uint32_t axisRectangleCrossings(const RayLanes& rays, const ExactAxisRectangle& 
 }
 
 uint32_t axisRectangleHits(const RayLanes& rays, const ExactAxisRectangle& rect, RectangleLanes& out,
-                           float* t) {
-  return HWY_DYNAMIC_DISPATCH(AxisRectangleHitsKernel)(rays, rect, out, t);
+                           float* t, const Vec2* uvCorners, float* u, float* v) {
+  return HWY_DYNAMIC_DISPATCH(AxisRectangleHitsKernel)(rays, rect, out, t, uvCorners, u, v);
 }
 
 uint32_t discCrossings(const RayLanes& rays, const ExactDisc& disc, const float* tMax, uint32_t lanes,

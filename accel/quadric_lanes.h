@@ -115,7 +115,10 @@ uint32_t axisRectangleCrossings(const RayLanes& rays, const ExactAxisRectangle& 
 // axisRectangleCrossings of the rays' live lanes (valid), also writing each lane's t rounded to
 // float into t[0, rays.n): a quad's hits in one call, without a pass for the live lanes first nor
 // one converting the hits' t lane by lane.
+// With `uvCorners` (the quad's UV at v0..v3) also each lane's texture coordinates into u and v,
+// exactly as Quad::rectangleUv computes them from the crossing: the plane coordinates in double,
+// rounded to float, then the UV of the half (v0, v1, v2) or (v0, v2, v3) they fall in.
 uint32_t axisRectangleHits(const RayLanes& rays, const ExactAxisRectangle& rect, RectangleLanes& out,
-                           float* t);
+                           float* t, const Vec2* uvCorners = nullptr, float* u = nullptr, float* v = nullptr);
 
 }  // namespace ember

@@ -279,13 +279,14 @@ uint32_t PlaneCrossingsKernel(const RayLanes& rays, const DoublePlane& plane, co
   return hits;
 }
 
-void FillFlatHits(const Vec3& n, LaneHits& out) {
+void FillFlatHits(const Vec3& n, bool zeroUv, LaneHits& out) {
   const D d;
   const V nx = hn::Set(d, n.x), ny = hn::Set(d, n.y), nz = hn::Set(d, n.z), zero = hn::Zero(d);
   for (unsigned i = 0; i < LaneHits::kLanes; i += unsigned(hn::Lanes(d))) {
     hn::Store(nx, d, out.ng[0] + i);
     hn::Store(ny, d, out.ng[1] + i);
     hn::Store(nz, d, out.ng[2] + i);
+    if (!zeroUv) continue;
     hn::Store(zero, d, out.uv[0] + i);
     hn::Store(zero, d, out.uv[1] + i);
   }
@@ -305,8 +306,8 @@ HWY_EXPORT(SphereHitsKernel);
 HWY_EXPORT(PlaneCrossingsKernel);
 HWY_EXPORT(FillFlatHits);
 
-void LaneHits::fillFlat(const Vec3& n) {
-  HWY_DYNAMIC_DISPATCH(FillFlatHits)(n, *this);
+void LaneHits::fillFlat(const Vec3& n, bool zeroUv) {
+  HWY_DYNAMIC_DISPATCH(FillFlatHits)(n, zeroUv, *this);
 }
 
 TriangleFilter TriangleFilter::of(const Vec3& v0, const Vec3& v1, const Vec3& v2, const DoublePlane& plane,

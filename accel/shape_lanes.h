@@ -75,7 +75,8 @@ struct LaneHits {
   // (and, where wanted, uv) are written.
   // With whole-vector stores (a Highway kernel): the callback's commit reads these arrays back
   // as vectors at once, and a load spanning several narrower stores would wait for them to retire.
-  void fillFlat(const Vec3& n);
+  // `zeroUv` false: uv is left as it is (a kernel wrote it).
+  void fillFlat(const Vec3& n, bool zeroUv = true);
 };
 
 // A triangle (v0, v1, v2) as its float filter sees it: the plane dot(n, x) = d, and the dual

@@ -262,15 +262,12 @@ void Quad::intersectLanes(const RayLanes& rays, LaneHits& out) const {
   if (axisAligned_) {
     // Every live lane through the exact test at once: a ray that reaches an axis-aligned
     // rectangle's bounding box has crossed its plane within its bounds, so it nearly always hits.
+    // Their texture coordinates too, in the kernel (rectangleUv for every lane at once).
     RectangleLanes crossings;
-    out.mask = axisRectangleHits(rays, exactRectangle_, crossings, out.t);
-    if (out.mask == 0) return;
-    out.fillFlat(normal_);
-    if (rays.needsUv)
-      for (uint32_t bits = out.mask; bits != 0; bits &= bits - 1) {
-        const unsigned i = unsigned(__builtin_ctz(bits));
-        setUv(out, i, rectangleUv(crossings.a[i], crossings.b[i]));
-      }
+    out.mask = rays.needsUv ? axisRectangleHits(rays, exactRectangle_, crossings, out.t, uv_.data(),
+                                                out.uv[0], out.uv[1])
+                            : axisRectangleHits(rays, exactRectangle_, crossings, out.t);
+    if (out.mask != 0) out.fillFlat(normal_, !rays.needsUv);
     return;
   }
   out.mask = 0;
