@@ -15,6 +15,7 @@ class Lambertian final : public Material {
       : reflectance_(std::move(reflectance)), reflects_(!isBlack(reflectance_->maxValue())) {
     mayAbsorb_ = reflectance_->mayBeBlack();
     usesLobe_ = false;  // one lobe
+    nonDeltaLobes_ = reflects_;
   }
 
   std::string_view typeName() const override { return "diffuse"; }
@@ -26,7 +27,6 @@ class Lambertian final : public Material {
   // Blocks of sampleCosineLanes.
   void sampleLanes(const SurfaceHit* const* hits, const Vec3* wo, const Vec2* u, const float* uLobe, size_t n,
                    BsdfSample* out, bool* ok) const override;
-  bool hasNonDeltaLobes() const override { return reflects_; }
   bool readsUv() const override { return !reflectance_->isConstant(); }
 
  private:

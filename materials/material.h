@@ -42,8 +42,9 @@ class Material {
     for (size_t i = 0; i < n; ++i) ok[i] = sample(*hits[i], wo[i], u[i], uLobe[i], out[i]);
   }
 
-  // Whether eval can be non-zero, i.e. light sampling is worth a shadow ray.
-  virtual bool hasNonDeltaLobes() const { return true; }
+  // Whether eval can be non-zero, i.e. light sampling is worth a shadow ray. A flag each material
+  // sets where it is made: the bounce asks at every vertex.
+  bool hasNonDeltaLobes() const { return nonDeltaLobes_; }
   // Whether sample() can return a Dirac lobe (a mirror or a smooth refraction): such surfaces
   // cast caustics (renderer/caustic_tracer.h).
   virtual bool hasDeltaLobes() const { return false; }
@@ -76,6 +77,7 @@ class Material {
   virtual bool absorbsEverythingAt(const SurfaceHit& /*hit*/) const { return false; }
   bool mayAbsorb_ = false;                       // some hit may be black in every lobe
   bool usesDirection_ = true, usesLobe_ = true;  // see usesDirectionSample
+  bool nonDeltaLobes_ = true;                    // see hasNonDeltaLobes
 };
 
 // wo and wi on the same geometric side of the surface (a reflection, not a transmission).

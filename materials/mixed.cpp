@@ -5,10 +5,6 @@
 
 namespace ember {
 
-bool Mixed::hasNonDeltaLobes() const {
-  return !isBlack(c_.kd->maxValue()) || !isBlack(c_.ks);
-}
-
 bool Mixed::hasDeltaLobes() const {
   return !isBlack(c_.kr) || !isBlack(c_.kt);
 }

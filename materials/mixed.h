@@ -25,13 +25,14 @@ struct MixedCoefficients {
 
 class Mixed final : public Material {
  public:
-  explicit Mixed(MixedCoefficients c) : c_(std::move(c)), lobe_{c_.exponent} {}
+  explicit Mixed(MixedCoefficients c) : c_(std::move(c)), lobe_{c_.exponent} {
+    nonDeltaLobes_ = !isBlack(c_.kd->maxValue()) || !isBlack(c_.ks);
+  }
 
   std::string_view typeName() const override { return "mixed"; }
   Color eval(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const override;
   float pdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const override;
   bool sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float uLobe, BsdfSample& out) const override;
-  bool hasNonDeltaLobes() const override;
   bool hasDeltaLobes() const override;
   bool readsUv() const override { return !c_.kd->isConstant(); }  // kd is its only texture
 

@@ -19,12 +19,12 @@ class Mirror final : public Material {
  public:
   explicit Mirror(const Color& reflectance) : reflectance_(reflectance) {
     usesDirection_ = usesLobe_ = false;  // one direction, always taken
+    nonDeltaLobes_ = false;
   }
   std::string_view typeName() const override { return "mirror"; }
   Color eval(const SurfaceHit&, const Vec3&, const Vec3&) const override { return Color(0.0f); }
   float pdf(const SurfaceHit&, const Vec3&, const Vec3&) const override { return 0.0f; }
   bool sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float uLobe, BsdfSample& out) const override;
-  bool hasNonDeltaLobes() const override { return false; }
   bool hasDeltaLobes() const override { return true; }
   bool readsUv() const override { return false; }
 
@@ -37,12 +37,12 @@ class Refraction final : public Material {
   Refraction(const Color& transmittance, float iorInside, float iorOutside)
       : transmittance_(transmittance), iorInside_(iorInside), iorOutside_(iorOutside) {
     usesDirection_ = usesLobe_ = false;  // Snell's direction, or total internal reflection
+    nonDeltaLobes_ = false;
   }
   std::string_view typeName() const override { return "refraction"; }
   Color eval(const SurfaceHit&, const Vec3&, const Vec3&) const override { return Color(0.0f); }
   float pdf(const SurfaceHit&, const Vec3&, const Vec3&) const override { return 0.0f; }
   bool sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float uLobe, BsdfSample& out) const override;
-  bool hasNonDeltaLobes() const override { return false; }
   bool hasDeltaLobes() const override { return true; }
   bool readsUv() const override { return false; }
 
@@ -55,12 +55,12 @@ class Dielectric final : public Material {
  public:
   Dielectric(float iorInside, float iorOutside) : iorInside_(iorInside), iorOutside_(iorOutside) {
     usesDirection_ = false;  // uLobe chooses reflection or refraction, each one direction
+    nonDeltaLobes_ = false;
   }
   std::string_view typeName() const override { return "dielectric"; }
   Color eval(const SurfaceHit&, const Vec3&, const Vec3&) const override { return Color(0.0f); }
   float pdf(const SurfaceHit&, const Vec3&, const Vec3&) const override { return 0.0f; }
   bool sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float uLobe, BsdfSample& out) const override;
-  bool hasNonDeltaLobes() const override { return false; }
   bool hasDeltaLobes() const override { return true; }
   bool readsUv() const override { return false; }
 
