@@ -11,7 +11,7 @@ Color Lambertian::eval(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) co
   if (!sameSide(hit, wo, wi)) return Color(0.0f);
   const float cosI = glm::dot(wi, facingNormal(hit, wo));
   if (cosI <= 0.0f) return Color(0.0f);
-  return reflectance_->evalAt(hit) * (cosI * kInvPi);
+  return reflectanceAt(hit) * (cosI * kInvPi);
 }
 
 float Lambertian::pdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const {
@@ -27,7 +27,7 @@ Color Lambertian::evalPdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi,
   const float cosI = glm::dot(wi, facingNormal(hit, wo));
   pdfOut = cosineHemispherePdf(cosI);
   if (cosI <= 0.0f) return Color(0.0f);
-  return reflectance_->evalAt(hit) * (cosI * kInvPi);
+  return reflectanceAt(hit) * (cosI * kInvPi);
 }
 
 // One live lane of the kernel, so that one vertex and a wave of them get the same direction.
@@ -58,7 +58,7 @@ bool Lambertian::finishSample(const SurfaceHit& hit, const Vec3& wo, const Vec3&
   out.pdf = pdf;
   // With a shading normal the sampled direction can dip below the geometric surface: absorb it.
   if (out.pdf <= 0.0f || !sameSide(hit, wo, out.wi)) return false;
-  out.weight = reflectance_->evalAt(hit);
+  out.weight = reflectanceAt(hit);
   out.delta = false;
   out.eta = 1.0f;
   return true;

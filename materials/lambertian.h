@@ -12,7 +12,10 @@ namespace ember {
 class Lambertian final : public Material {
  public:
   explicit Lambertian(std::shared_ptr<const Texture> reflectance)
-      : reflectance_(std::move(reflectance)), reflects_(!isBlack(reflectance_->maxValue())) {
+      : reflectance_(std::move(reflectance)),
+        reflects_(!isBlack(reflectance_->maxValue())),
+        constant_(reflectance_->isConstant()),
+        constantValue_(reflectance_->maxValue()) {
     mayAbsorb_ = reflectance_->mayBeBlack();
     usesLobe_ = false;  // one lobe
     nonDeltaLobes_ = reflects_;
@@ -27,17 +30,22 @@ class Lambertian final : public Material {
   // Blocks of sampleCosineLanes.
   void sampleLanes(const SurfaceHit* const* hits, const Vec3* wo, const Vec2* u, const float* uLobe, size_t n,
                    BsdfSample* out, bool* ok) const override;
-  bool readsUv() const override { return !reflectance_->isConstant(); }
+  bool readsUv() const override { return !constant_; }
 
  private:
-  bool absorbsEverythingAt(const SurfaceHit& hit) const override {
-    return isBlack(reflectance_->evalAt(hit));
+  bool absorbsEverythingAt(const SurfaceHit& hit) const override { return isBlack(reflectanceAt(hit)); }
+  // The reflectance at the hit: a constant one without the texture's virtual call, which
+  // evalPdf and the BSDF sample would otherwise make at every vertex.
+  Color reflectanceAt(const SurfaceHit& hit) const {
+    return constant_ ? constantValue_ : reflectance_->evalAt(hit);
   }
   // The sample from the kernel's direction and pdf.
   bool finishSample(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi, float pdf, BsdfSample& out) const;
 
   std::shared_ptr<const Texture> reflectance_;
-  bool reflects_;  // some channel of the reflectance is non-zero somewhere
+  bool reflects_;        // some channel of the reflectance is non-zero somewhere
+  bool constant_;        // the texture is the same everywhere (Texture::isConstant)
+  Color constantValue_;  // then its value, which is its maxValue
 };
 
 }  // namespace ember
