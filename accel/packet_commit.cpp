@@ -35,9 +35,21 @@ hn::Vec<D> loadHitField(D d, const T* p) {
   return hn::LoadU(d, p);
 }
 
+// p[k] = v[k] where keep[k]: a masked store where the CPU has one (AVX-512); elsewhere Highway
+// emulates it (vmaskmov on AVX2, lane by lane before), so the blend with the old values is stored.
+template <class D, class V, class M, typename T>
+HWY_INLINE void storeKept(V v, M keep, D d, T* p) {
+#if HWY_TARGET <= HWY_AVX3
+  hn::BlendedStore(v, keep, d, p);
+#else
+  hn::StoreU(hn::IfThenElse(keep, v, hn::LoadU(d, p)), d, p);
+#endif
+}
+
 // Commits lanes [i, i + Lanes(d)) of the block, as the scalar rule below decides each. tfar and
 // geomID are read back as whole vectors (by Embree, and by the next shape's commit), so they are
-// stored whole; the other fields, read one lane at a time after the trace, with masked stores.
+// stored whole; the other fields, read one lane at a time after the trace, with masked stores
+// (storeKept).
 template <class D>
 void commitVector(D d, unsigned i, const LaneHits& hits, float* tfar, const HitFields& out, uint32_t primID,
                   uint32_t geomID, uint32_t instID) {
@@ -56,11 +68,11 @@ void commitVector(D d, unsigned i, const LaneHits& hits, float* tfar, const HitF
   const auto keepU = hn::RebindMask(du, keep);
   hn::StoreU(hn::IfThenElse(keep, t, current), d, tfar + i);
   hn::StoreU(hn::IfThenElse(keepU, ours, currentGeometry), du, out.geomID + i);
-  for (int c = 0; c < 3; ++c) hn::BlendedStore(loadHitField(d, hits.ng[c] + i), keep, d, out.ng[c] + i);
-  hn::BlendedStore(loadHitField(d, hits.uv[0] + i), keep, d, out.u + i);
-  hn::BlendedStore(loadHitField(d, hits.uv[1] + i), keep, d, out.v + i);
-  hn::BlendedStore(hn::Set(du, primID), keepU, du, out.primID + i);
-  hn::BlendedStore(hn::Set(du, instID), keepU, du, out.instID + i);
+  for (int c = 0; c < 3; ++c) storeKept(loadHitField(d, hits.ng[c] + i), keep, d, out.ng[c] + i);
+  storeKept(loadHitField(d, hits.uv[0] + i), keep, d, out.u + i);
+  storeKept(loadHitField(d, hits.uv[1] + i), keep, d, out.v + i);
+  storeKept(hn::Set(du, primID), keepU, du, out.primID + i);
+  storeKept(hn::Set(du, instID), keepU, du, out.instID + i);
 }
 
 void CommitLaneHits(const LaneHits& hits, unsigned n, float* tfar, RTCHitN* packet, unsigned width,
