@@ -218,8 +218,9 @@ bool Quad::settledHit(int half, const Ray& ray, float tMin, float tMax, bool nee
   return true;
 }
 
-// The UV of an axis-aligned rectangle's crossing at coordinates (a, b), from intersect() and
-// intersectLanes() alike.
+// The UV of an axis-aligned rectangle's crossing at coordinates (a, b), for intersect();
+// intersectLanes() has the rectangle kernel compute the same (rectangleUvLanes in
+// accel/quadric_lanes.cpp), held to this bit for bit by tests/test_shape_lanes.cpp.
 Vec2 Quad::rectangleUv(double a, double b) const {
   const ExactAxisRectangle& r = exactRectangle_;
   return parallelogramUv(Vec2(float((a - r.corner[0]) / r.edge[0]), float((b - r.corner[1]) / r.edge[1])));

@@ -13,12 +13,11 @@ class Lambertian final : public Material {
  public:
   explicit Lambertian(std::shared_ptr<const Texture> reflectance)
       : reflectance_(std::move(reflectance)),
-        reflects_(!isBlack(reflectance_->maxValue())),
         constant_(reflectance_->isConstant()),
         constantValue_(reflectance_->maxValue()) {
     mayAbsorb_ = reflectance_->mayBeBlack();
-    usesLobe_ = false;  // one lobe
-    nonDeltaLobes_ = reflects_;
+    usesLobe_ = false;                                    // one lobe
+    nonDeltaLobes_ = !isBlack(reflectance_->maxValue());  // some channel reflects somewhere
   }
 
   std::string_view typeName() const override { return "diffuse"; }
@@ -43,7 +42,6 @@ class Lambertian final : public Material {
   bool finishSample(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi, float pdf, BsdfSample& out) const;
 
   std::shared_ptr<const Texture> reflectance_;
-  bool reflects_;        // some channel of the reflectance is non-zero somewhere
   bool constant_;        // the texture is the same everywhere (Texture::isConstant)
   Color constantValue_;  // then its value, which is its maxValue
 };
