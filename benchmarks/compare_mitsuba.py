@@ -52,6 +52,26 @@ def ember_column(kernel, sampler, caustics):
     return name if caustics == "trace" else name + "-pathcaustics"
 
 
+def print_table(rows, cols):
+    """The markdown table of `rows`, each compared with the first Mitsuba variant among `cols`."""
+    pixels = 256 * 256
+    base = next(c for c in cols if not c.startswith("ember"))
+    head = "| scene | spp | " + " | ".join(f"{c} relMSE" for c in cols) + " | " + \
+           " | ".join(f"{c} Msamples/s" for c in cols) + " | " + \
+           " | ".join(f"efficiency {c} / {base}" for c in cols if c != base) + " | " + \
+           " | ".join(f"samples/s {c} / {base}" for c in cols if c != base) + " |"
+    print(head)
+    print("|" + "---|" * (head.count("|") - 1))
+    eff = lambda x: 1.0 / (x["relmse"] * x["seconds"])
+    for r in rows:
+        cells = [r["scene"], str(r["spp"])] + [f"{r[c]['relmse']:.5f}" for c in cols]
+        cells += [f"{pixels * r['spp'] / r[c]['seconds'] / 1e6:.2f}" for c in cols]
+        cells += [f"{eff(r[c]) / eff(r[base]):.2f}" for c in cols if c != base]
+        # Issue 10's samples/s target: the same spp, so the ratio of the render times.
+        cells += [f"{r[base]['seconds'] / r[c]['seconds']:.2f}" for c in cols if c != base]
+        print("| " + " | ".join(cells) + " |")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--scenes", nargs="*", default=["cornell-area", "cornell-point", "shapes", "textured"])
@@ -65,7 +85,17 @@ def main():
     ap.add_argument("--threads", type=int, default=os.cpu_count())
     ap.add_argument("--ember", default=os.path.join(ROOT, "build", "app", "ember"))
     ap.add_argument("--json", help="also write the raw numbers here")
+    ap.add_argument("--table-from", metavar="JSON",
+                    help="render nothing: print the table of an earlier run's --json file")
     args = ap.parse_args()
+
+    if args.table_from:
+        with open(args.table_from) as f:
+            rows = json.load(f)
+        cols = [k for k in rows[0] if k not in ("scene", "spp")]
+        ember = [c for c in cols if c.startswith("ember")]
+        print_table(rows, ember + [c for c in cols if c not in ember])
+        return
 
     import mitsuba as mi
     import mitsuba_scene
@@ -105,21 +135,8 @@ def main():
             rows.append(row)
             print(json.dumps(row), file=sys.stderr, flush=True)
 
-    pixels = 256 * 256
     cols = [ember_column(k, s, c) for k, s, c in itertools.product(args.kernels, args.samplers, args.caustics)]
-    cols += args.variants
-    base = args.variants[0]
-    head = "| scene | spp | " + " | ".join(f"{c} relMSE" for c in cols) + " | " + \
-           " | ".join(f"{c} Msamples/s" for c in cols) + " | " + \
-           " | ".join(f"efficiency {c} / {base}" for c in cols if c != base) + " |"
-    print(head)
-    print("|" + "---|" * (head.count("|") - 1))
-    eff = lambda x: 1.0 / (x["relmse"] * x["seconds"])
-    for r in rows:
-        cells = [r["scene"], str(r["spp"])] + [f"{r[c]['relmse']:.5f}" for c in cols]
-        cells += [f"{pixels * r['spp'] / r[c]['seconds'] / 1e6:.2f}" for c in cols]
-        cells += [f"{eff(r[c]) / eff(r[base]):.2f}" for c in cols if c != base]
-        print("| " + " | ".join(cells) + " |")
+    print_table(rows, cols + args.variants)
     if args.json:
         with open(args.json, "w") as f:
             json.dump(rows, f, indent=1)
