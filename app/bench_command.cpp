@@ -145,6 +145,10 @@ int runBench(const BenchArgs& a) {
         {"shadow_rays_per_second", double(med.paths.shadowRays) / s},
         {"rays_per_second", double(med.paths.rays + med.paths.shadowRays) / s},
         {"nonfinite_samples", med.nonFinite},
+        // Traversal on Ember's own rays (the batched kernels time their batches' trace calls):
+        // its thread-seconds, and its share of the render's thread-seconds. 0 for --kernel scalar.
+        {"trace_seconds", double(med.paths.traceNanoseconds) * 1e-9},
+        {"trace_share", double(med.paths.traceNanoseconds) * 1e-9 / (s * med.threads)},
         {"peak_resident_mb", peakResidentMb()},
         {"anonymous_resident_mb", anonymousMb},
     };

@@ -4,6 +4,7 @@
 #include "packet/bsdf_batch.h"
 #include "packet/geometry_groups.h"
 #include "packet/hit_prefetch.h"
+#include "packet/timed_trace.h"
 #include "renderer/sampler_lanes.h"
 #include "renderer/scene.h"
 
@@ -104,7 +105,7 @@ void traceCausticsInWaves(const Scene& scene, int maxDepth, int rrDepth, uint64_
         }
         while (active > 0) {
           local.rays += active;
-          wave.closest.trace(scene.accel(), traversal);
+          traceTimed(wave.closest, scene.accel(), traversal, local);
           // CausticTracer::onHit in its steps, each for the whole bounce: arrival and the camera
           // connections, then the BSDFs' numbers and samples, then the next rays.
           wave.shadows.clear();
@@ -145,7 +146,7 @@ void traceCausticsInWaves(const Scene& scene, int maxDepth, int rrDepth, uint64_
             }
           }
           local.shadowRays += wave.shadows.size();
-          wave.shadows.trace(scene.accel(), traversal);
+          traceTimed(wave.shadows, scene.accel(), traversal, local);
           for (size_t j = 0; j < wave.shadows.size(); ++j)
             if (!wave.shadows.occluded(j) &&
                 !splats.add(wave.splatImage[j], wave.splats[j].x, wave.splats[j].y, wave.splats[j].value))

@@ -4,6 +4,7 @@
 #include "packet/bsdf_batch.h"
 #include "packet/caustic_wave.h"
 #include "packet/hit_prefetch.h"
+#include "packet/timed_trace.h"
 #include "renderer/sampler_lanes.h"
 
 #include <algorithm>
@@ -135,7 +136,7 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
 
     while (active > 0) {
       stats.rays += active;
-      wave.closest.trace(scene.accel(), traversal_);
+      traceTimed(wave.closest, scene.accel(), traversal_, stats);
 
       // The steps of PathIntegrator::onHit, each for the whole bounce: arrival and the light
       // choice, then the lights' samples, then shadow rays and scattering.
@@ -204,7 +205,7 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
         }
       }
 
-      wave.shadows.trace(scene.accel(), traversal_);
+      traceTimed(wave.shadows, scene.accel(), traversal_, stats);
       for (size_t j = 0; j < wave.shadows.size(); ++j)
         if (!wave.shadows.occluded(j))
           wave.lanes[wave.shadowOwner[j]].path.radiance += wave.shadowContribution[j];

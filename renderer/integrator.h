@@ -16,12 +16,17 @@ struct PathStats {
   uint64_t shadowRays = 0;  // occlusion queries
   uint64_t vertices = 0;    // surface hits
   uint64_t nonFinite = 0;   // samples dropped because they were NaN or infinite
+  // Wall time the batched kernels spent in their batches' trace calls (Embree and the shapes'
+  // callbacks), summed over threads: how much of a render is traversal (`ember bench`'s
+  // trace_seconds). The scalar kernel, one ray per call, does not time its rays.
+  uint64_t traceNanoseconds = 0;
 
   PathStats& operator+=(const PathStats& o) {
     rays += o.rays;
     shadowRays += o.shadowRays;
     vertices += o.vertices;
     nonFinite += o.nonFinite;
+    traceNanoseconds += o.traceNanoseconds;
     return *this;
   }
 };

@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <string>
 
 namespace ember {
 namespace {
@@ -38,6 +39,31 @@ TEST(BenchCommand, JsonReportsTheBuildAndTheRates) {
                            "shadow_rays_per_second", "rays_per_second"})
     EXPECT_GT(scene.at(rate).get<double>(), 0.0) << rate;
   EXPECT_EQ(scene.at("nonfinite_samples"), 0);
+}
+
+// trace_seconds and trace_share: the batched kernels time their batches' trace calls, which are
+// a part of the render and never all of it; the scalar kernel, one ray per call, times none.
+TEST(BenchCommand, TraceShareComesFromTheBatchedKernels) {
+  test::TempDir dir;
+  for (const char* kernel : {"wavefront", "stream", "scalar"}) {
+    const std::string out = dir.file(std::string(kernel) + ".json");
+    const test::CliResult r =
+        test::runEmber("bench '" + test::sourcePath("scenes/cornell-point.json") +
+                       "' --spp 2 --repeat 1 --threads 1 --kernel " + kernel + " --json '" + out + "'");
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    std::ifstream in(out);
+    const nlohmann::json scene = nlohmann::json::parse(in).at("scenes")[0];
+    const double seconds = scene.at("trace_seconds"), share = scene.at("trace_share");
+    if (std::string(kernel) == "scalar") {
+      EXPECT_EQ(seconds, 0.0);
+      EXPECT_EQ(share, 0.0);
+    } else {
+      EXPECT_GT(seconds, 0.0) << kernel;
+      EXPECT_LT(seconds, scene.at("render_seconds_median").get<double>()) << kernel;
+      EXPECT_GT(share, 0.0) << kernel;
+      EXPECT_LT(share, 1.0) << kernel;
+    }
+  }
 }
 
 // --packet-width: the report says the width the render used, whatever this machine's native one

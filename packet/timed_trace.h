@@ -1,0 +1,23 @@
+// A batch traced with its wall time added to the thread's PathStats::traceNanoseconds, so that
+// `ember bench` can report how much of a render is traversal (Embree and the shapes' callbacks)
+// on the renderer's own rays, beside benchmarks/embree_raw_throughput's synthetic ray mix. Two
+// clock reads per batch of up to a wave's rays: nothing next to the rays themselves.
+#pragma once
+
+#include "packet/ray_batch.h"
+#include "renderer/integrator.h"
+
+#include <chrono>
+
+namespace ember {
+
+template <class Batch>
+void traceTimed(Batch& batch, const EmbreeAccel& accel, BatchTraversal traversal, PathStats& stats) {
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point start = Clock::now();
+  batch.trace(accel, traversal);
+  stats.traceNanoseconds +=
+      uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - start).count());
+}
+
+}  // namespace ember
