@@ -1,8 +1,12 @@
 // Raw Embree throughput in the cornell-area geometry: the "limit" Ember's path vertices/s are
-// compared with (docs/performance.md). Casts the same ray mix a path tracer does — incoherent
-// closest-hit rays starting on surfaces inside the box, and shadow rays from those points to the
-// area light — as single rays (rtcIntersect1/rtcOccluded1) and as 8- and 16-wide packets, on 1 and
-// on all threads. The scene is Ember's own (analytic user geometry), so the numbers include the
+// compared with (docs/performance.md). Casts a synthetic form of a path tracer's ray mix —
+// incoherent closest-hit rays starting on surfaces inside the box, and shadow rays from those
+// points to the area light — as single rays (rtcIntersect1/rtcOccluded1) and as 8- and 16-wide
+// packets, on 1 and on all threads. It is harder than Ember's own mix: every vertex casts a shadow
+// ray (Ember's cast 0.65 per vertex there: none where the light is behind the surface or the
+// material is a Dirac one), no ray is a coherent camera ray, and consecutive rays start at random
+// points of the box. `ember bench`'s trace_share measures Ember's own rays (benchmarks/
+// limit_fraction.py reports both). The scene is Ember's own (analytic user geometry), so the numbers include the
 // cost of our intersection callbacks, exactly as Ember pays it, and the rays carry the Embree masks
 // Ember's own carry (Shape::flat, Shape::convexSide).
 //   embree_raw_throughput [scene.json] [--rays N] [--mix-only]
