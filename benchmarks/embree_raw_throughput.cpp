@@ -5,10 +5,10 @@
 // packets, on 1 and on all threads. It is harder than Ember's own mix: every vertex casts a shadow
 // ray (Ember's cast 0.65 per vertex there: none where the light is behind the surface or the
 // material is a Dirac one), no ray is a coherent camera ray, and consecutive rays start at random
-// points of the box. `ember bench`'s trace_share measures Ember's own rays (benchmarks/
-// limit_fraction.py reports both). The scene is Ember's own (analytic user geometry), so the numbers include the
-// cost of our intersection callbacks, exactly as Ember pays it, and the rays carry the Embree masks
-// Ember's own carry (Shape::flat, Shape::convexSide).
+// points of the box. `ember bench`'s trace_share measures Ember's own rays
+// (benchmarks/limit_fraction.py reports both). The scene is Ember's own (analytic user geometry), so
+// the numbers include the cost of our intersection callbacks, exactly as Ember pays it, and the rays
+// carry the Embree masks Ember's own carry (Shape::flat, Shape::convexSide).
 //   embree_raw_throughput [scene.json] [--rays N] [--mix-only]
 // --mix-only measures the two vertex-mix rows alone (the limit), for benchmarks/limit_fraction.py.
 #include "core/sampling.h"
