@@ -5,6 +5,7 @@
 #include "io/input_error.h"
 #include "io/scene_loader.h"
 #include "packet/wavefront_integrator.h"
+#include "renderer/path_phases.h"
 #include "renderer/render.h"
 
 #include <sys/resource.h>
@@ -68,6 +69,7 @@ struct BenchArgs {
   std::string json;
   std::string kernel = "wavefront";
   std::string packetWidth = "auto";
+  bool phases = false;
   std::string caustics;  // "trace", "path", or empty: each scene's render.caustic_tracing
 };
 
@@ -115,6 +117,7 @@ int runBench(const BenchArgs& a) {
     options.seed = scene.settings.seed;
     options.sampler = scene.settings.sampler;
     options.threads = a.threads;
+    options.timePhases = a.phases;
     std::vector<RenderStats> runs;
     double anonymousMb = 0.0;
     for (int k = 0; k < a.repeat; ++k) {
@@ -152,6 +155,12 @@ int runBench(const BenchArgs& a) {
         {"peak_resident_mb", peakResidentMb()},
         {"anonymous_resident_mb", anonymousMb},
     };
+    if (a.phases) {
+      nlohmann::json phases = nlohmann::json::object();
+      for (size_t i = 0; i < kPathPhases; ++i)
+        phases[std::string(kPathPhaseNames[i])] = double(med.paths.phaseNanoseconds[i]) * 1e-9;
+      row["phase_seconds"] = phases;
+    }
     report["scenes"].push_back(row);
     std::printf(
         "%-22s %7d %5d %8.3f %8.3f %9.3f %10.3f %10.3f %10.3f %10.3f %9llu %8.1f %8.1f\n",
@@ -201,6 +210,9 @@ Runner addBenchCommand(CLI::App& app) {
          "--caustics", args->caustics,
          "trace or path, as `ember render --caustics` (default: each scene's render.caustic_tracing)")
       ->check(CLI::IsMember({"trace", "path"}));
+  cmd->add_flag("--phases", args->phases,
+                "Also time the batched kernels' bounce step by step (phase_seconds in the JSON; a few "
+                "clock reads per bounce)");
   cmd->add_option("--json", args->json, "Also write the results as JSON (layout: docs/performance.md)");
   return [args] { return runBench(*args); };
 }

@@ -112,6 +112,7 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
   // Camera samples are taken sample index by sample index, each over all of the tile's pixels.
   for (uint64_t first = 0; first < total; first += Wave::kSize) {
     const size_t count = size_t(std::min<uint64_t>(Wave::kSize, total - first));
+    PhaseClock phases(work.timePhases, stats.phaseNanoseconds);
     size_t active = 0;
     // Each ray goes into the next batch where it is made, while its path is in cache.
     wave.closest.clear();
@@ -134,9 +135,11 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
       }
     }
 
+    phases.mark(PathPhase::Camera);
     while (active > 0) {
       stats.rays += active;
       traceTimed(wave.closest, scene.accel(), traversal_, stats);
+      phases.mark(PathPhase::TraceClosest);
 
       // The steps of PathIntegrator::onHit, each for the whole bounce: arrival and the light
       // choice, then the lights' samples, then shadow rays and scattering.
@@ -163,6 +166,7 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
         }
         ++vertices;
       }
+      phases.mark(PathPhase::Arrival);
       // pickLight for the bounce: its 1D, then its 2D request, then the choice.
       draw1DThen2DLanes(wave.samplerOf.data(), lightDraws, wave.drawn1D.data(), wave.drawn2D.data(),
                         lightUse);
@@ -171,7 +175,9 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
         if (PathIntegrator::pickLightWith(scene, wave.drawn1D[j], wave.drawn2D[j], wave.picks[v]))
           wave.queryKey[queries++] = uint64_t(wave.picks[v].light->samplerIndex) << 16 | v;
       }
+      phases.mark(PathPhase::LightChoice);
       sampleLights(wave, queries, lights.size());
+      phases.mark(PathPhase::LightSamples);
 
       wave.shadows.clear();
       size_t next = 0;
@@ -191,10 +197,12 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
         const Material& material = *wave.hits[v].material;
         wave.bsdfUse[v] = {material.usesDirectionSample(), material.usesLobeSample()};
       }
+      phases.mark(PathPhase::NextEvent);
       // PathIntegrator::drawBsdfSample for the bounce: its 2D, then its 1D request.
       draw2DThen1DLanes(wave.samplerOf.data(), vertices, wave.bsdfs.u.data(), wave.bsdfs.uLobe.data(),
                         wave.bsdfUse.data());
       wave.bsdfs.sampleAll(vertices);
+      phases.mark(PathPhase::BsdfSamples);
       wave.closest.clear();  // its hits are all read
       for (size_t v = 0; v < vertices; ++v) {
         Wave::Lane& lane = wave.lanes[wave.vertexLane[v]];
@@ -205,17 +213,20 @@ void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, F
         }
       }
 
+      phases.mark(PathPhase::Continuation);
       traceTimed(wave.shadows, scene.accel(), traversal_, stats);
       for (size_t j = 0; j < wave.shadows.size(); ++j)
         if (!wave.shadows.occluded(j))
           wave.lanes[wave.shadowOwner[j]].path.radiance += wave.shadowContribution[j];
       std::swap(wave.active, wave.next);
       active = next;
+      phases.mark(PathPhase::TraceShadows);
     }
 
     for (size_t i = 0; i < count; ++i)
       addToFilm(film, work, wave.lanes[i].x, wave.lanes[i].y, int((first + i) / pixels),
                 wave.lanes[i].path.radiance, stats);
+    phases.mark(PathPhase::Camera);  // the film, with the pixels' other work
   }
 }
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "renderer/film.h"
+#include "renderer/path_phases.h"
 #include "renderer/sampler.h"
 #include "renderer/scene.h"
 
@@ -20,6 +21,9 @@ struct PathStats {
   // callbacks), summed over threads: how much of a render is traversal (`ember bench`'s
   // trace_seconds). The scalar kernel, one ray per call, does not time its rays.
   uint64_t traceNanoseconds = 0;
+  // The batched path tracer's time by step of the bounce (renderer/path_phases.h), summed over
+  // threads, where the render asked for it (TileWork::timePhases); zeros otherwise.
+  std::array<uint64_t, kPathPhases> phaseNanoseconds{};
 
   PathStats& operator+=(const PathStats& o) {
     rays += o.rays;
@@ -27,6 +31,7 @@ struct PathStats {
     vertices += o.vertices;
     nonFinite += o.nonFinite;
     traceNanoseconds += o.traceNanoseconds;
+    for (size_t i = 0; i < kPathPhases; ++i) phaseNanoseconds[i] += o.phaseNanoseconds[i];
     return *this;
   }
 };
@@ -41,6 +46,7 @@ struct TileWork {
   // The light tracer's splats for the pass (image s for sample index firstSample + s), added to
   // each sample; null when the render traces no caustics.
   const CausticSplats* caustics = nullptr;
+  bool timePhases = false;  // charge the batched kernels' time to PathStats::phaseNanoseconds
 };
 
 class Integrator {

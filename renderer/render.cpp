@@ -102,6 +102,7 @@ RenderStats render(const Scene& scene, const Integrator& integrator, const Rende
               work.seed = options.seed;
               work.sampler = options.sampler;
               work.caustics = traceCaustics ? &splats : nullptr;
+              work.timePhases = options.timePhases;
               if (options.stop) film.save(work.x0, work.y0, work.x1, work.y1, backups[size_t(t)]);
               integrator.renderTile(scene, work, film, local);
               rendered[size_t(t)] = 1;

@@ -24,6 +24,7 @@ struct RenderOptions {
   int tileSize = 16;
   SamplerType sampler = SamplerType::Independent;
   bool progress = false;
+  bool timePhases = false;  // PathStats::phaseNanoseconds (the batched kernels; `ember bench --phases`)
 
   int passSpp = 4;     // samples per pixel per pass (the last pass may take fewer)
   int passesDone = 0;  // passes the film already holds (a resumed render): pass p renders sample

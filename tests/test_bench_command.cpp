@@ -1,5 +1,6 @@
 // `ember bench` as a user runs it: the JSON report's layout (docs/performance.md, "ember bench
 // --json"), which tells builds apart, and bad input.
+#include "renderer/path_phases.h"
 #include "tests/cli_runner.h"
 #include "tests/test_paths.h"
 
@@ -64,6 +65,40 @@ TEST(BenchCommand, TraceShareComesFromTheBatchedKernels) {
       EXPECT_LT(share, 1.0) << kernel;
     }
   }
+}
+
+// --phases: every step of the bounce is timed, the steps together are most of the render and never
+// more, and the two trace steps contain the trace calls that trace_seconds times. Without the flag
+// the report has no phases.
+TEST(BenchCommand, PhasesAddUpToTheRender) {
+  test::TempDir dir;
+  const std::string out = dir.file("phases.json");
+  const test::CliResult r = test::runEmber("bench '" + test::sourcePath("scenes/cornell-point.json") +
+                                           "' --spp 2 --repeat 1 --threads 1 --phases --json '" + out + "'");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  std::ifstream in(out);
+  const nlohmann::json scene = nlohmann::json::parse(in).at("scenes")[0];
+  const nlohmann::json& phases = scene.at("phase_seconds");
+  ASSERT_EQ(phases.size(), kPathPhases);
+  double sum = 0.0;
+  for (const std::string_view name : kPathPhaseNames) {
+    const double seconds = phases.at(std::string(name));
+    EXPECT_GT(seconds, 0.0) << name;
+    sum += seconds;
+  }
+  const double render = scene.at("render_seconds_median");
+  EXPECT_LE(sum, render);
+  EXPECT_GT(sum, 0.5 * render);
+  EXPECT_GE(phases.at("trace_closest").get<double>() + phases.at("trace_shadows").get<double>(),
+            scene.at("trace_seconds").get<double>());
+
+  const std::string plain = dir.file("plain.json");
+  ASSERT_EQ(test::runEmber("bench '" + test::sourcePath("scenes/cornell-point.json") +
+                           "' --spp 1 --repeat 1 --threads 1 --json '" + plain + "'")
+                .exitCode,
+            0);
+  std::ifstream plainIn(plain);
+  EXPECT_FALSE(nlohmann::json::parse(plainIn).at("scenes")[0].contains("phase_seconds"));
 }
 
 // --packet-width: the report says the width the render used, whatever this machine's native one
