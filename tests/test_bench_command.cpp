@@ -14,6 +14,18 @@
 namespace ember {
 namespace {
 
+// The report's one scene, of `ember bench` on cornell-point at 1 thread with `flags` (the report
+// written in `dir` as `name`).
+nlohmann::json benchCornellPoint(const test::TempDir& dir, const std::string& name,
+                                 const std::string& flags) {
+  const std::string out = dir.file(name);
+  const test::CliResult r = test::runEmber("bench '" + test::sourcePath("scenes/cornell-point.json") +
+                                           "' --repeat 1 --threads 1 " + flags + " --json '" + out + "'");
+  EXPECT_EQ(r.exitCode, 0) << r.output;
+  std::ifstream in(out);
+  return nlohmann::json::parse(in).at("scenes")[0];
+}
+
 TEST(BenchCommand, JsonReportsTheBuildAndTheRates) {
   test::TempDir dir;
   const std::string out = dir.file("bench.json");
@@ -46,16 +58,10 @@ TEST(BenchCommand, JsonReportsTheBuildAndTheRates) {
 // a part of the render and never all of it; the scalar kernel, one ray per call, times none.
 TEST(BenchCommand, TraceShareComesFromTheBatchedKernels) {
   test::TempDir dir;
-  for (const char* kernel : {"wavefront", "stream", "scalar"}) {
-    const std::string out = dir.file(std::string(kernel) + ".json");
-    const test::CliResult r =
-        test::runEmber("bench '" + test::sourcePath("scenes/cornell-point.json") +
-                       "' --spp 2 --repeat 1 --threads 1 --kernel " + kernel + " --json '" + out + "'");
-    ASSERT_EQ(r.exitCode, 0) << r.output;
-    std::ifstream in(out);
-    const nlohmann::json scene = nlohmann::json::parse(in).at("scenes")[0];
+  for (const std::string kernel : {"wavefront", "stream", "scalar"}) {
+    const nlohmann::json scene = benchCornellPoint(dir, kernel + ".json", "--spp 2 --kernel " + kernel);
     const double seconds = scene.at("trace_seconds"), share = scene.at("trace_share");
-    if (std::string(kernel) == "scalar") {
+    if (kernel == "scalar") {
       EXPECT_EQ(seconds, 0.0);
       EXPECT_EQ(share, 0.0);
     } else {
@@ -72,12 +78,7 @@ TEST(BenchCommand, TraceShareComesFromTheBatchedKernels) {
 // the report has no phases.
 TEST(BenchCommand, PhasesAddUpToTheRender) {
   test::TempDir dir;
-  const std::string out = dir.file("phases.json");
-  const test::CliResult r = test::runEmber("bench '" + test::sourcePath("scenes/cornell-point.json") +
-                                           "' --spp 2 --repeat 1 --threads 1 --phases --json '" + out + "'");
-  ASSERT_EQ(r.exitCode, 0) << r.output;
-  std::ifstream in(out);
-  const nlohmann::json scene = nlohmann::json::parse(in).at("scenes")[0];
+  const nlohmann::json scene = benchCornellPoint(dir, "phases.json", "--spp 2 --phases");
   const nlohmann::json& phases = scene.at("phase_seconds");
   ASSERT_EQ(phases.size(), kPathPhases);
   double sum = 0.0;
@@ -92,13 +93,7 @@ TEST(BenchCommand, PhasesAddUpToTheRender) {
   EXPECT_GE(phases.at("trace_closest").get<double>() + phases.at("trace_shadows").get<double>(),
             scene.at("trace_seconds").get<double>());
 
-  const std::string plain = dir.file("plain.json");
-  ASSERT_EQ(test::runEmber("bench '" + test::sourcePath("scenes/cornell-point.json") +
-                           "' --spp 1 --repeat 1 --threads 1 --json '" + plain + "'")
-                .exitCode,
-            0);
-  std::ifstream plainIn(plain);
-  EXPECT_FALSE(nlohmann::json::parse(plainIn).at("scenes")[0].contains("phase_seconds"));
+  EXPECT_FALSE(benchCornellPoint(dir, "plain.json", "--spp 1").contains("phase_seconds"));
 }
 
 // --packet-width: the report says the width the render used, whatever this machine's native one
