@@ -7,6 +7,7 @@
 
 #include "packet/ray_batch.h"
 #include "renderer/integrator.h"
+#include "renderer/path_phases.h"
 
 #include <chrono>
 
@@ -14,11 +15,9 @@ namespace ember {
 
 template <class Batch>
 void traceTimed(Batch& batch, const EmbreeAccel& accel, BatchTraversal traversal, PathStats& stats) {
-  using Clock = std::chrono::steady_clock;
-  const Clock::time_point start = Clock::now();
+  const std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
   batch.trace(accel, traversal);
-  stats.traceNanoseconds +=
-      uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - start).count());
+  stats.traceNanoseconds += nanosecondsBetween(start, std::chrono::steady_clock::now());
 }
 
 }  // namespace ember

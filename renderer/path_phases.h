@@ -13,7 +13,7 @@
 namespace ember {
 
 enum class PathPhase : uint8_t {
-  Camera,        // pixel numbers, camera rays, paths started
+  Camera,        // pixel numbers, camera rays, paths started, and the film when they end
   TraceClosest,  // the closest-hit batch through Embree and the shapes' callbacks
   Arrival,       // hits grouped by geometry, hit records, emission, absorption
   LightChoice,   // the light choice's numbers and the choice
@@ -31,6 +31,13 @@ inline constexpr std::array<std::string_view, kPathPhases> kPathPhaseNames = {
     "next_event", "bsdf_samples",  "continuation", "trace_shadows",
 };
 
+// Nanoseconds from `from` to `to` on the steady clock: what PhaseClock and traceTimed
+// (packet/timed_trace.h) add up.
+inline uint64_t nanosecondsBetween(std::chrono::steady_clock::time_point from,
+                                   std::chrono::steady_clock::time_point to) {
+  return uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(to - from).count());
+}
+
 // Adds the time since the previous mark (or since construction) to the phase named. Off, it reads
 // no clock: a branch per phase and bounce, nothing per ray.
 class PhaseClock {
@@ -41,8 +48,7 @@ class PhaseClock {
   void mark(PathPhase phase) {
     if (!on_) return;
     const Clock::time_point now = Clock::now();
-    totals_[size_t(phase)] +=
-        uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(now - last_).count());
+    totals_[size_t(phase)] += nanosecondsBetween(last_, now);
     last_ = now;
   }
 
