@@ -14,13 +14,14 @@ corpus=build-fuzz/corpus
 mkdir -p "$corpus"/{scene_json,gltf,checkpoint,image}
 # Seeds: Ember's own scenes; glTF files of every kind, valid and deliberately broken (Debian's
 # assimp-testmodels, the generated showcases, the Khronos samples beside a checkout, the inputs
-# fuzzing found crashing: tests/data/fuzz, so each stays fixed under the sanitizers); a real
+# fuzzing found crashing: tests/data/fuzz, so each stays fixed under the sanitizers; fuzz/seeds,
+# files that reach parts of the loader the others do not, such as sparse accessors); a real
 # checkpoint. Copied, so the fuzzer's new inputs never land in the source tree.
 cp scenes/*.json "$corpus/scene_json/"
 # Only the folders that exist: find fails on a missing one, and pipefail would end the run (a clone
 # without ../shared beside it).
 seed_dirs=()
-for d in scenes/gltf tests/data/fuzz /usr/share/assimp/models/glTF2 ../shared/assets/gltf; do
+for d in scenes/gltf tests/data/fuzz fuzz/seeds /usr/share/assimp/models/glTF2 ../shared/assets/gltf; do
   if [ -d "$d" ]; then seed_dirs+=("$d"); fi
 done
 # Under 1 MiB each, as the image seeds below: a larger seed slows every execution. (find rounds a

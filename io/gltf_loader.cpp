@@ -415,30 +415,82 @@ class GltfImporter {
     return model_.accessors[size_t(index)];
   }
 
+  // Calls fn(element bytes, i) for each of the accessor's elements i that is stored: the buffer
+  // view's elements in order, then each sparse substitution (glTF 2.0 section 3.6.2.3: the base
+  // elements, or zeros without a buffer view, with `count` of them replaced by the values at the
+  // indices given). Elements stored nowhere are zeros, which callers' outputs start as.
   template <typename Fn>
   void forEachElement(const tinygltf::Accessor& acc, const std::string& where, Fn fn) const {
-    if (acc.sparse.isSparse) fail(where, "sparse accessors are not supported");
-    if (acc.bufferView < 0) return;  // spec: no buffer view means all zeros
-    if (size_t(acc.bufferView) >= model_.bufferViews.size()) fail(where, "bufferView index out of range");
-    const tinygltf::BufferView& view = model_.bufferViews[size_t(acc.bufferView)];
-    if (view.buffer < 0 || size_t(view.buffer) >= model_.buffers.size())
-      fail(where, "buffer index out of range");
-    const tinygltf::Buffer& buffer = model_.buffers[size_t(view.buffer)];
     const int componentSize = tinygltf::GetComponentSizeInBytes(uint32_t(acc.componentType));
     const int components = tinygltf::GetNumComponentsInType(uint32_t(acc.type));
     if (componentSize <= 0 || components <= 0) fail(where, "invalid component type or accessor type");
     const size_t elementSize = size_t(componentSize) * size_t(components);
+    if (acc.bufferView >= 0) {
+      const ElementBytes base =
+          elementBytes(acc.bufferView, acc.byteOffset, acc.count, elementSize, true, where);
+      for (size_t i = 0; i < acc.count; ++i) fn(base.first + i * base.stride, i);
+    }
+    if (acc.sparse.isSparse) forEachSparseElement(acc, elementSize, where + ".sparse", fn);
+  }
+
+  template <typename Fn>
+  void forEachSparseElement(const tinygltf::Accessor& acc, size_t elementSize, const std::string& where,
+                            Fn fn) const {
+    const auto& sparse = acc.sparse;
+    if (sparse.count < 1 || size_t(sparse.count) > acc.count)
+      fail(where + ".count", "expected 1.." + std::to_string(acc.count) + " (the accessor's count), got " +
+                                 std::to_string(sparse.count));
+    const size_t count = size_t(sparse.count);
+    const int indexSize = tinygltf::GetComponentSizeInBytes(uint32_t(sparse.indices.componentType));
+    if (sparse.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+        sparse.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+        sparse.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+      fail(where + ".indices.componentType", "must be an unsigned integer type");
+    const ElementBytes indices = elementBytes(sparse.indices.bufferView, sparse.indices.byteOffset, count,
+                                              size_t(indexSize), false, where + ".indices");
+    const ElementBytes values = elementBytes(sparse.values.bufferView, sparse.values.byteOffset, count,
+                                             elementSize, false, where + ".values");
+    size_t previous = 0;
+    for (size_t j = 0; j < count; ++j) {
+      uint32_t index = 0;
+      std::memcpy(&index, indices.first + j * size_t(indexSize), size_t(indexSize));  // little-endian
+      if (index >= acc.count)
+        fail(where + ".indices", "index " + std::to_string(index) + " (entry " + std::to_string(j) +
+                                     ") is past the accessor's " + std::to_string(acc.count) + " elements");
+      if (j > 0 && index <= previous)
+        fail(where + ".indices", "indices must strictly increase (entry " + std::to_string(j) + ")");
+      previous = index;
+      fn(values.first + j * elementSize, size_t(index));
+    }
+  }
+
+  struct ElementBytes {
+    const uint8_t* first;
+    size_t stride;
+  };
+  // Where `count` elements of `elementSize` bytes start in buffer view `viewIndex` at `byteOffset`,
+  // after checking that every byte lies inside the view and its buffer. Sparse indices and values
+  // are tightly packed: their views may not set byteStride (`strided` false).
+  ElementBytes elementBytes(int viewIndex, size_t byteOffset, size_t count, size_t elementSize, bool strided,
+                            const std::string& where) const {
+    if (viewIndex < 0 || size_t(viewIndex) >= model_.bufferViews.size())
+      fail(where, "bufferView index " + std::to_string(viewIndex) + " out of range");
+    const tinygltf::BufferView& view = model_.bufferViews[size_t(viewIndex)];
+    if (view.buffer < 0 || size_t(view.buffer) >= model_.buffers.size())
+      fail(where, "buffer index out of range");
+    const tinygltf::Buffer& buffer = model_.buffers[size_t(view.buffer)];
+    if (!strided && view.byteStride) fail(where, "the bufferView of sparse data must not set byteStride");
     const size_t stride = view.byteStride ? view.byteStride : elementSize;
     if (stride < elementSize) fail(where, "byteStride smaller than the element size");
     if (view.byteOffset > buffer.data.size() || view.byteLength > buffer.data.size() - view.byteOffset)
       fail(where, "bufferView extends past the end of its buffer (buffer has " +
                       std::to_string(buffer.data.size()) + " bytes)");
-    if (acc.count == 0) return;
-    const size_t needed = acc.byteOffset + stride * (acc.count - 1) + elementSize;
-    if (acc.byteOffset > view.byteLength || needed > view.byteLength || needed < acc.byteOffset)
+    const uint8_t* first = buffer.data.data() + view.byteOffset;
+    if (count == 0) return {first, stride};
+    const size_t needed = byteOffset + stride * (count - 1) + elementSize;
+    if (byteOffset > view.byteLength || needed > view.byteLength || needed < byteOffset)
       fail(where, "accessor reads past the end of its bufferView");
-    const uint8_t* base = buffer.data.data() + view.byteOffset + acc.byteOffset;
-    for (size_t i = 0; i < acc.count; ++i) fn(base + i * stride, i);
+    return {first + byteOffset, stride};
   }
 
   // glTF points and lines have no width (rasterisers draw them one pixel wide), which a path tracer

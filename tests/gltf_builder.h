@@ -146,14 +146,8 @@ class GltfBuilder {
     return int(model_.nodes.size()) - 1;
   }
 
-  bool write(const std::string& path) {
-    tinygltf::TinyGLTF writer;
-    return writer.WriteGltfSceneToFile(&model_, path, /*embedImages=*/true, /*embedBuffers=*/true,
-                                       /*prettyPrint=*/true, /*writeBinary=*/false);
-  }
-
- private:
-  int addAccessor(const void* data, size_t bytes, int componentType, int type, size_t count) {
+  // Appends `bytes` to the buffer (4-byte aligned) as a buffer view of their own; returns its index.
+  int addBufferView(const void* data, size_t bytes) {
     tinygltf::Buffer& buffer = model_.buffers[0];
     while (buffer.data.size() % 4) buffer.data.push_back(0);
     tinygltf::BufferView view;
@@ -163,8 +157,19 @@ class GltfBuilder {
     buffer.data.resize(buffer.data.size() + bytes);
     std::memcpy(buffer.data.data() + view.byteOffset, data, bytes);
     model_.bufferViews.push_back(view);
+    return int(model_.bufferViews.size()) - 1;
+  }
+
+  bool write(const std::string& path) {
+    tinygltf::TinyGLTF writer;
+    return writer.WriteGltfSceneToFile(&model_, path, /*embedImages=*/true, /*embedBuffers=*/true,
+                                       /*prettyPrint=*/true, /*writeBinary=*/false);
+  }
+
+ private:
+  int addAccessor(const void* data, size_t bytes, int componentType, int type, size_t count) {
     tinygltf::Accessor accessor;
-    accessor.bufferView = int(model_.bufferViews.size()) - 1;
+    accessor.bufferView = addBufferView(data, bytes);
     accessor.componentType = componentType;
     accessor.type = type;
     accessor.count = count;
