@@ -343,7 +343,7 @@ class GltfImporter {
     const tinygltf::Accessor& acc = checkedAccessor(index, where);
     if (acc.type != expectedType) fail(where, "unexpected accessor type");
     const int components = tinygltf::GetNumComponentsInType(uint32_t(acc.type));
-    count = acc.count;
+    count = checkedCount(acc, where);
     std::vector<float> out(count * size_t(components), 0.0f);
     // Integer components are normalised when the accessor says so (always for TEXCOORD and COLOR
     // in core glTF; KHR_mesh_quantization allows the rest): unsigned c / max, signed max(c / max, -1).
@@ -387,7 +387,7 @@ class GltfImporter {
   std::vector<uint32_t> readIndices(int index, const std::string& where) {
     const tinygltf::Accessor& acc = checkedAccessor(index, where);
     if (acc.type != TINYGLTF_TYPE_SCALAR) fail(where, "index accessor must be SCALAR");
-    std::vector<uint32_t> out(acc.count);
+    std::vector<uint32_t> out(checkedCount(acc, where));
     forEachElement(acc, where, [&](const uint8_t* src, size_t i) {
       switch (acc.componentType) {
         case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
@@ -421,10 +421,7 @@ class GltfImporter {
   // indices given). Elements stored nowhere are zeros, which callers' outputs start as.
   template <typename Fn>
   void forEachElement(const tinygltf::Accessor& acc, const std::string& where, Fn fn) const {
-    const int componentSize = tinygltf::GetComponentSizeInBytes(uint32_t(acc.componentType));
-    const int components = tinygltf::GetNumComponentsInType(uint32_t(acc.type));
-    if (componentSize <= 0 || components <= 0) fail(where, "invalid component type or accessor type");
-    const size_t elementSize = size_t(componentSize) * size_t(components);
+    const size_t elementSize = elementSizeOf(acc, where);
     if (acc.bufferView >= 0) {
       const ElementBytes base =
           elementBytes(acc.bufferView, acc.byteOffset, acc.count, elementSize, true, where);
@@ -464,6 +461,31 @@ class GltfImporter {
     }
   }
 
+  size_t elementSizeOf(const tinygltf::Accessor& acc, const std::string& where) const {
+    const int componentSize = tinygltf::GetComponentSizeInBytes(uint32_t(acc.componentType));
+    const int components = tinygltf::GetNumComponentsInType(uint32_t(acc.type));
+    if (componentSize <= 0 || components <= 0) fail(where, "invalid component type or accessor type");
+    return size_t(componentSize) * size_t(components);
+  }
+
+  // Elements an accessor without a buffer view may have: all zeros but for sparse substitutions,
+  // so its count is bounded by nothing in the file. 2^24 is far more vertices than a mesh Ember
+  // can render on one machine has, and its arrays stay within a few hundred MB.
+  static constexpr size_t kMaxElementsWithoutView = size_t(1) << 24;
+
+  // The accessor's count, checked before anything is allocated for it: the elements of a buffer
+  // view must lie inside it (elementBytes), and a count without one is capped.
+  size_t checkedCount(const tinygltf::Accessor& acc, const std::string& where) const {
+    const size_t elementSize = elementSizeOf(acc, where);
+    if (acc.bufferView >= 0)
+      elementBytes(acc.bufferView, acc.byteOffset, acc.count, elementSize, true, where);
+    else if (acc.count > kMaxElementsWithoutView)
+      fail(where, "an accessor without a bufferView may have at most " +
+                      std::to_string(kMaxElementsWithoutView) + " elements, not " +
+                      std::to_string(acc.count));
+    return acc.count;
+  }
+
   struct ElementBytes {
     const uint8_t* first;
     size_t stride;
@@ -487,9 +509,14 @@ class GltfImporter {
                       std::to_string(buffer.data.size()) + " bytes)");
     const uint8_t* first = buffer.data.data() + view.byteOffset;
     if (count == 0) return {first, stride};
-    const size_t needed = byteOffset + stride * (count - 1) + elementSize;
-    if (byteOffset > view.byteLength || needed > view.byteLength || needed < byteOffset)
-      fail(where, "accessor reads past the end of its bufferView");
+    // Element k occupies [byteOffset + k stride, + elementSize): all of them fit if the first does
+    // and the last starts within the room after it. Divided, not multiplied: a count from the
+    // file can make `stride * count` wrap.
+    if (byteOffset > view.byteLength || elementSize > view.byteLength - byteOffset ||
+        count - 1 > (view.byteLength - byteOffset - elementSize) / stride)
+      fail(where, std::to_string(count) + " elements of " + std::to_string(elementSize) + " bytes (stride " +
+                      std::to_string(stride) + ") from byte " + std::to_string(byteOffset) +
+                      " read past the end of the bufferView (" + std::to_string(view.byteLength) + " bytes)");
     return {first + byteOffset, stride};
   }
 

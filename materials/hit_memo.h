@@ -2,7 +2,7 @@
 // material or texture looks up at a vertex, which the integrator asks for more than once per
 // vertex (the light sample's evalPdf, then sample; Phong and the mixed material a third time for
 // their lobe choice). Texture lookups repeated so were 16% of a textured glTF render's
-// instructions (docs/performance.md, nineteenth session).
+// instructions (docs/performance-history.md, nineteenth session).
 //
 // Why it never changes a value: a slot is reused only when its key, the owner's id and the UV's
 // bits, equals the request's, and equal keys are equal arguments of the same pure function. Owner

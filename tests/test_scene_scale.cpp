@@ -1,9 +1,10 @@
 // A scene's image does not depend on its units or on where it sits: the shared scenes scaled by
 // 2^-12 and 2^12 (a point light's intensity by the square, so that the irradiance it gives is
-// unchanged), and moved 100 units away from the origin, must still match the Mitsuba references
-// by the z-tests of test_reference_images.cpp. Ray offsets and shadow-ray ends are sized by each
-// point's own rounding error (core/ray_spawn.h), which grows with its coordinates. The test has the
-// power to see what that costs: moved 1,000 units away, cornell-area fails it (8 of 768 blocks, max
+// unchanged), and moved by (100, 70, -30), must still match the Mitsuba references by the z-tests
+// of test_reference_images.cpp. Ray offsets and shadow-ray ends are sized by each point's own
+// rounding error (core/ray_spawn.h): 2e-6 of its coordinates' magnitude with a floor of 1e-7, so
+// the test probes the floor at 2^-12 and the growth far from the origin. It has the power to see
+// what that growth costs: moved by (1000, 700, -300), cornell-area fails it (8 of 768 blocks, max
 // |z| 6.5), because the 2 mm offsets there swallow the gap under the glass sphere that rests on the
 // floor, and with it 5-8% of its caustic (docs/architecture.md, "Hit points and ray origins").
 #include "io/image_compare.h"
@@ -77,6 +78,13 @@ TEST_P(PlacedScene, MatchesTheReferenceWithinNoise) {
   const std::filesystem::path path = std::filesystem::temp_directory_path() /
                                      ("ember_placed_" + std::to_string(::getpid()) + "_" + c.scene + ".json");
   std::ofstream(path) << moved.dump(1);
+  struct RemovedAtTheEnd {
+    std::filesystem::path path;
+    ~RemovedAtTheEnd() {
+      std::error_code ec;
+      std::filesystem::remove(path, ec);
+    }
+  } removed{path};
 
   Image mean, variance;
   for (const uint64_t seed : {1u, 2u}) {
@@ -96,7 +104,6 @@ TEST_P(PlacedScene, MatchesTheReferenceWithinNoise) {
       variance.rgb[i] = 0.25f * (variance.rgb[i] + v.rgb[i]);
     }
   }
-  std::filesystem::remove(path);
   const std::string ref = test::sourcePath("tests/data/" + c.scene + "/");
   const BlockZTestResult r = blockZTest(mean, variance, readImageRgb(ref + "reference.exr"),
                                         squared(readImageRgb(ref + "stderr.exr")), kBlock, kAlpha);
@@ -108,7 +115,7 @@ TEST_P(PlacedScene, MatchesTheReferenceWithinNoise) {
 
 constexpr Placement kTiny{"scaled_by_2_pow_minus_12", 1.0 / 4096.0, {0, 0, 0}};
 constexpr Placement kHuge{"scaled_by_2_pow_12", 4096.0, {0, 0, 0}};
-constexpr Placement kFar{"moved_100_units_away", 1.0, {100.0, 70.0, -30.0}};
+constexpr Placement kFar{"moved_by_100_70_minus_30", 1.0, {100.0, 70.0, -30.0}};
 
 INSTANTIATE_TEST_SUITE_P(SharedScenes, PlacedScene,
                          ::testing::Values(Case{"cornell-point", kTiny}, Case{"cornell-point", kHuge},
