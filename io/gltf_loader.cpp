@@ -592,6 +592,15 @@ class GltfImporter {
       fail(where + ".mode", "unknown primitive mode " + std::to_string(mode));
     const auto pos = prim.attributes.find("POSITION");
     if (pos == prim.attributes.end()) fail(where, "primitive has no POSITION attribute");
+    // Vertex colours multiply the base colour (glTF 2.0 section 3.7.2.1); Ember renders without
+    // them, and says so once per file, so that a grey render of a vertex-painted model is explained.
+    if (!warnedVertexColours_ && prim.attributes.count("COLOR_0")) {
+      warnedVertexColours_ = true;
+      std::fprintf(stderr,
+                   "ember: %s: %s.attributes.COLOR_0: vertex colours are not supported; the material's base "
+                   "colour is used without them\n",
+                   path_.c_str(), where.c_str());
+    }
     size_t vertexCount = 0;
     const std::vector<float> positions =
         readFloats(pos->second, TINYGLTF_TYPE_VEC3, where + ".attributes.POSITION", vertexCount);
@@ -695,6 +704,7 @@ class GltfImporter {
   GltfImport result_;
   std::set<std::string> usedOverrides_;
   std::vector<PointsOrLines> pointsAndLines_;
+  bool warnedVertexColours_ = false;
 };
 
 }  // namespace

@@ -395,6 +395,35 @@ TEST(GltfExtensions, UnsupportedRequiredExtensionIsAnErrorAndAnUsedOneAWarning) 
       << r.output;
 }
 
+// COLOR_0 is not rendered; a file with it says so once, naming the first primitive that has it.
+TEST(GltfAttributes, VertexColoursAreNamedInOneWarning) {
+  TempDir dir;
+  GltfBuilder b;
+  const int material = b.addMaterial(pbr("paint", {0.5, 0.5, 0.5, 1}, 0, 1));
+  b.addQuad(1.0f, material);
+  b.addQuad(0.5f, material);
+  const float colours[16] = {1, 0, 0, 1, 0, 1, 0, 1, 0, 0, 1, 1, 1, 1, 1, 1};
+  const int view = b.addBufferView(colours, sizeof colours);
+  tinygltf::Accessor accessor;
+  accessor.bufferView = view;
+  accessor.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
+  accessor.type = TINYGLTF_TYPE_VEC4;
+  accessor.count = 4;
+  b.model().accessors.push_back(accessor);
+  for (tinygltf::Mesh& mesh : b.model().meshes)
+    mesh.primitives.at(0).attributes["COLOR_0"] = int(b.model().accessors.size()) - 1;
+  ASSERT_TRUE(b.write(dir.file("colours.gltf")));
+  const auto r = test::runEmber("render '" + dir.file("colours.gltf") +
+                                "' --spp 1 --width 8 --height 8 -q -o " + dir.file("c.exr"));
+  EXPECT_EQ(r.exitCode, 0) << r.output;
+  const std::string warning =
+      "colours.gltf: meshes[0].primitives[0].attributes.COLOR_0: vertex colours are not supported";
+  const size_t first = r.output.find(warning);
+  EXPECT_NE(first, std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("COLOR_0", first + warning.size()), std::string::npos) << "warned twice:\n"
+                                                                                 << r.output;
+}
+
 TEST(GltfOverrides, UnknownMaterialNameListsTheFilesMaterials) {
   TempDir dir;
   const std::string gltf = twoCameraFile(dir);
