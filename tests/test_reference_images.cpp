@@ -10,15 +10,10 @@
 // fail. The Sobol sampler is checked against the references too (conservatively: its samples are
 // not independent, so their sample variance overestimates the noise).
 #include "accel/sphere.h"
-#include "io/image_compare.h"
-#include "io/image_io.h"
-#include "io/image_metrics.h"
-#include "io/scene_loader.h"
 #include "materials/lambertian.h"
+#include "reference_comparison.h"
 #include "renderer/path_integrator.h"
 #include "renderer/render.h"
-#include "test_fixtures.h"
-#include "test_paths.h"
 
 #include <gtest/gtest.h>
 
@@ -31,46 +26,16 @@ constexpr int kSpp = 64;
 constexpr int kBlock = 16;
 constexpr double kAlpha = 0.01;
 
-struct Rendered {
-  Image mean, variance;
-};
+using test::average;
+using test::describe;
+using test::loadReference;
+using test::Reference;
+using test::Rendered;
 
 Rendered renderScene(const std::string& name, uint64_t seed, int spp,
                      const std::function<void(Scene&)>& mutate = {},
                      SamplerType sampler = SamplerType::Independent) {
-  Scene scene = loadJsonScene(test::sourcePath("scenes/" + name + ".json"));
-  if (mutate) mutate(scene);
-  scene.build();
-  RenderStats stats;
-  const Film film = test::renderFilm(scene, spp, seed, &stats, sampler);
-  EXPECT_EQ(stats.nonFinite, 0u);
-  return {film.mean(), film.varianceOfMean()};
-}
-
-struct Reference {
-  Image mean, variance;
-};
-
-Reference loadReference(const std::string& name) {
-  const std::string dir = test::sourcePath("tests/data/" + name + "/");
-  return {readImageRgb(dir + "reference.exr"), squared(readImageRgb(dir + "stderr.exr"))};
-}
-
-// The average of two independent renders, with the variance of that average.
-Rendered average(const Rendered& a, const Rendered& b) {
-  Rendered m = a;
-  for (size_t i = 0; i < m.mean.rgb.size(); ++i) {
-    m.mean.rgb[i] = 0.5f * (a.mean.rgb[i] + b.mean.rgb[i]);
-    m.variance.rgb[i] = 0.25f * (a.variance.rgb[i] + b.variance.rgb[i]);
-  }
-  return m;
-}
-
-std::string describe(const BlockZTestResult& r) {
-  return std::to_string(r.failures) + "/" + std::to_string(r.tests) + " blocks beyond |z| > " +
-         std::to_string(r.threshold) + ", max |z| " + std::to_string(r.maxAbsZ) + ", image-mean z (" +
-         std::to_string(r.meanZ[0]) + ", " + std::to_string(r.meanZ[1]) + ", " + std::to_string(r.meanZ[2]) +
-         ")";
+  return test::renderFile(test::sourcePath("scenes/" + name + ".json"), seed, spp, mutate, sampler);
 }
 
 class ReferenceImage : public ::testing::TestWithParam<std::string> {};
@@ -116,12 +81,7 @@ TEST_P(ReferenceImage, SobolSamplerMatchesMitsuba) {
 
 INSTANTIATE_TEST_SUITE_P(SharedScenes, ReferenceImage,
                          ::testing::Values("cornell-area", "cornell-point", "shapes", "textured"),
-                         [](const auto& info) {
-                           std::string s = info.param;
-                           for (char& c : s)
-                             if (c == '-') c = '_';
-                           return s;
-                         });
+                         [](const auto& info) { return test::testName(info.param); });
 
 // The other two estimators of direct light (renderer/strategy.h) are unbiased too, so they must
 // match the same references. BSDF sampling alone cannot reach cornell-point's point light.
@@ -155,10 +115,7 @@ INSTANTIATE_TEST_SUITE_P(
                       StrategyCase{"shapes", Strategy::Light}, StrategyCase{"textured", Strategy::Bsdf},
                       StrategyCase{"textured", Strategy::Light}),
     [](const auto& info) {
-      std::string s = info.param.scene + "_" + std::string(strategyName(info.param.strategy));
-      for (char& c : s)
-        if (c == '-') c = '_';
-      return s;
+      return test::testName(info.param.scene + "_" + std::string(strategyName(info.param.strategy)));
     });
 
 // --- the comparison must be able to fail ----------------------------------------------------

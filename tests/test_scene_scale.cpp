@@ -7,12 +7,8 @@
 // what that growth costs: moved by (1000, 700, -300), cornell-area fails it (8 of 768 blocks, max
 // |z| 6.5), because the 2 mm offsets there swallow the gap under the glass sphere that rests on the
 // floor, and with it 5-8% of its caustic (docs/architecture.md, "Hit points and ray origins").
-#include "io/image_compare.h"
-#include "io/image_io.h"
-#include "io/image_metrics.h"
-#include "io/scene_loader.h"
-#include "test_fixtures.h"
-#include "test_paths.h"
+
+#include "reference_comparison.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -86,49 +82,25 @@ TEST_P(PlacedScene, MatchesTheReferenceWithinNoise) {
     }
   } removed{path};
 
-  Image mean, variance;
-  for (const uint64_t seed : {1u, 2u}) {
-    Scene scene = loadJsonScene(path.string());
-    scene.build();
-    RenderStats stats;
-    const Film film = test::renderFilm(scene, kSpp, seed, &stats);
-    EXPECT_EQ(stats.nonFinite, 0u);
-    const Image m = film.mean(), v = film.varianceOfMean();
-    if (seed == 1) {
-      mean = m;
-      variance = v;
-      continue;
-    }
-    for (size_t i = 0; i < mean.rgb.size(); ++i) {  // the average of the two renders
-      mean.rgb[i] = 0.5f * (mean.rgb[i] + m.rgb[i]);
-      variance.rgb[i] = 0.25f * (variance.rgb[i] + v.rgb[i]);
-    }
-  }
-  const std::string ref = test::sourcePath("tests/data/" + c.scene + "/");
-  const BlockZTestResult r = blockZTest(mean, variance, readImageRgb(ref + "reference.exr"),
-                                        squared(readImageRgb(ref + "stderr.exr")), kBlock, kAlpha);
-  EXPECT_TRUE(r.passes()) << c.scene << ", " << c.placement.name << ": " << r.failures << "/" << r.tests
-                          << " blocks beyond |z| > " << r.threshold << ", max |z| " << r.maxAbsZ;
-  std::printf("[ %s, %s ] %zu/%zu blocks rejected, max |z| %.3f\n", c.scene.c_str(), c.placement.name,
-              size_t(r.failures), size_t(r.tests), r.maxAbsZ);
+  const test::Rendered both =
+      test::average(test::renderFile(path.string(), 1, kSpp), test::renderFile(path.string(), 2, kSpp));
+  const test::Reference ref = test::loadReference(c.scene);
+  const BlockZTestResult r = blockZTest(both.mean, both.variance, ref.mean, ref.variance, kBlock, kAlpha);
+  const std::string label = c.scene + ", " + c.placement.name;
+  EXPECT_TRUE(r.passes()) << label << ": " << test::describe(r);
+  std::printf("[ %s ] %s\n", label.c_str(), test::describe(r).c_str());
 }
 
 constexpr Placement kTiny{"scaled_by_2_pow_minus_12", 1.0 / 4096.0, {0, 0, 0}};
 constexpr Placement kHuge{"scaled_by_2_pow_12", 4096.0, {0, 0, 0}};
 constexpr Placement kFar{"moved_by_100_70_minus_30", 1.0, {100.0, 70.0, -30.0}};
 
-INSTANTIATE_TEST_SUITE_P(SharedScenes, PlacedScene,
-                         ::testing::Values(Case{"cornell-point", kTiny}, Case{"cornell-point", kHuge},
-                                           Case{"cornell-point", kFar}, Case{"cornell-area", kTiny},
-                                           Case{"cornell-area", kHuge}, Case{"cornell-area", kFar},
-                                           Case{"shapes", kTiny}, Case{"shapes", kHuge},
-                                           Case{"shapes", kFar}),
-                         [](const auto& info) {
-                           std::string s = info.param.scene + "_" + info.param.placement.name;
-                           for (char& ch : s)
-                             if (ch == '-') ch = '_';
-                           return s;
-                         });
+INSTANTIATE_TEST_SUITE_P(
+    SharedScenes, PlacedScene,
+    ::testing::Values(Case{"cornell-point", kTiny}, Case{"cornell-point", kHuge}, Case{"cornell-point", kFar},
+                      Case{"cornell-area", kTiny}, Case{"cornell-area", kHuge}, Case{"cornell-area", kFar},
+                      Case{"shapes", kTiny}, Case{"shapes", kHuge}, Case{"shapes", kFar}),
+    [](const auto& info) { return test::testName(info.param.scene + "_" + info.param.placement.name); });
 
 }  // namespace
 }  // namespace ember
