@@ -201,8 +201,8 @@ Runner addBenchCommand(CLI::App& app) {
   cmd->add_option("--repeat", args->repeat, "Renders per scene; the median is reported (default 3)")
       ->check(CLI::Range(1, 1000));
   cmd->add_option("--kernel", args->kernel,
-                  "wavefront (default), stream or scalar; see `ember render --help`")
-      ->check(CLI::IsMember({"wavefront", "stream", "scalar"}));
+                  "wavefront (default), stream, scalar or lanes; see `ember render --help`")
+      ->check(CLI::IsMember({"wavefront", "stream", "scalar", "lanes"}));
   cmd->add_option("--packet-width", args->packetWidth,
                   "auto (default), 8 or 16 rays per packet; see `ember render --help`")
       ->check(CLI::IsMember({"auto", "8", "16"}));

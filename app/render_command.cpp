@@ -372,10 +372,12 @@ Runner addRenderCommand(CLI::App& app) {
                   "to the camera: far less noise; the default) or path (the path tracer alone); default: the "
                   "scene's render.caustic_tracing")
       ->check(CLI::IsMember({"trace", "path"}));
-  cmd->add_option("--kernel", args->kernel,
-                  "How paths are traced, all giving the same image: wavefront (Embree packets, the default), "
-                  "stream (Embree ray streams) or scalar (one ray at a time, the reference)")
-      ->check(CLI::IsMember({"wavefront", "stream", "scalar"}));
+  cmd->add_option(
+         "--kernel", args->kernel,
+         "How paths are traced, all giving the same image: wavefront (Embree packets, the default), "
+         "stream (Embree ray streams), scalar (one ray at a time, the reference) or lanes (the bounce's "
+         "state in arrays, on analytic Lambertian scenes, the wavefront elsewhere; in development)")
+      ->check(CLI::IsMember({"wavefront", "stream", "scalar", "lanes"}));
   cmd->add_option(
          "--packet-width", args->packetWidth,
          "Rays per packet of the wavefront and stream kernels: auto (the default: 16 where Embree "

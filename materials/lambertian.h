@@ -30,6 +30,8 @@ class Lambertian final : public Material {
   void sampleLanes(const SurfaceHit* const* hits, const Vec3* wo, const Vec2* u, const float* uLobe, size_t n,
                    BsdfSample* out, bool* ok) const override;
   bool readsUv() const override { return !constant_; }
+  // The reflectance where it is the same everywhere; null where a texture varies it.
+  const Color* constantReflectance() const { return constant_ ? &constantValue_ : nullptr; }
 
  private:
   bool absorbsEverythingAt(const SurfaceHit& hit) const override { return isBlack(reflectanceAt(hit)); }

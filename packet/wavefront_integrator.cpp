@@ -4,6 +4,7 @@
 #include "packet/bsdf_batch.h"
 #include "packet/caustic_wave.h"
 #include "packet/hit_prefetch.h"
+#include "packet/lane_integrator.h"
 #include "packet/timed_trace.h"
 #include "renderer/sampler_lanes.h"
 
@@ -238,6 +239,7 @@ std::optional<Kernel> parseKernel(std::string_view name) {
   if (name == "wavefront") return Kernel::Wavefront;
   if (name == "stream") return Kernel::Stream;
   if (name == "scalar") return Kernel::Scalar;
+  if (name == "lanes") return Kernel::Lanes;
   return std::nullopt;
 }
 
@@ -247,6 +249,8 @@ std::unique_ptr<Integrator> makeIntegrator(const RenderSettings& settings, Kerne
       return std::make_unique<PathIntegrator>(settings);
     case Kernel::Stream:
       return std::make_unique<WavefrontIntegrator>(settings, BatchTraversal::Stream);
+    case Kernel::Lanes:
+      return std::make_unique<LaneIntegrator>(settings);
     case Kernel::Wavefront:
       break;
   }

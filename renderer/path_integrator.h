@@ -73,6 +73,7 @@ class PathIntegrator final : public Integrator {
   bool tracesCaustics() const override { return traceCaustics_; }
   int maxDepth() const override { return maxDepth_; }
   int rrDepth() const override { return rrDepth_; }
+  Strategy strategy() const { return strategy_; }
 
   // The scalar reference: casts each ray of the path alone, as soon as it is known.
   Color Li(const Scene& scene, Ray ray, Sampler& sampler, PathStats& stats) const override;

@@ -6,6 +6,7 @@
 #include "core/sampling.h"
 #include "io/scene_loader.h"
 #include "packet/geometry_groups.h"
+#include "packet/lane_integrator.h"
 #include "packet/wavefront_integrator.h"
 #include "renderer/render.h"
 
@@ -73,7 +74,8 @@ Scene loadSmall(const std::string& path, int width, int height) {
 }
 
 // The batched kernels at both packet widths (8: AVX2's native width, 16: AVX-512's), whatever
-// this machine's native width is.
+// this machine's native width is. The lane kernel renders the scenes it covers and hands the others
+// to the wavefront kernel: the same image either way.
 void expectKernelsAgree(Scene& scene, const std::string& name, const RenderCase& c = {}) {
   const Film reference = renderWith(scene, Kernel::Scalar, c);
   const unsigned native = scene.accel().packetWidth();
@@ -83,6 +85,7 @@ void expectKernelsAgree(Scene& scene, const std::string& name, const RenderCase&
     expectIdentical(reference, renderWith(scene, Kernel::Wavefront, c),
                     name + ": wavefront vs scalar" + packets);
     expectIdentical(reference, renderWith(scene, Kernel::Stream, c), name + ": stream vs scalar" + packets);
+    expectIdentical(reference, renderWith(scene, Kernel::Lanes, c), name + ": lanes vs scalar" + packets);
   }
   scene.setPacketWidth(native);
 }
@@ -148,6 +151,63 @@ TEST(Wavefront, SameImageAsScalarForEveryEmitterAndLight) {
   std::filesystem::remove(path);
 }
 
+// The scenes the lane kernel covers (packet/lane_integrator.h), at the edges of its set: every
+// analytic shape, emitters of every shape, one- and two-sided, facing in and out (a sphere whose
+// normals point inwards encloses the scene), point and spot lights, a black (absorbing) material,
+// paths cut by max depth and by Russian roulette from the second segment, both samplers, and
+// waves of one sample per pixel. The scene is then changed just outside the set, where the kernel
+// must hand it to the wavefront kernel. The camera is inside the inward-facing sphere.
+TEST(LaneKernel, SameImageAsScalarOnTheScenesItCovers) {
+  const std::string path = (std::filesystem::temp_directory_path() / "ember_lanes_covered.json").string();
+  std::ofstream(path) << R"({
+    "image": {"width": 29, "height": 23},
+    "camera": {"origin": [0, 1.1, 1.3], "target": [0, 0.6, 0], "up": [0, 1, 0], "fov_y_deg": 50},
+    "render": {"max_depth": 7, "rr_depth": 2},
+    "materials": {
+      "white": {"type": "diffuse", "reflectance": [0.7, 0.7, 0.7]},
+      "red": {"type": "diffuse", "reflectance": [0.6, 0.1, 0.05]},
+      "black": {"type": "diffuse", "reflectance": [0, 0, 0]}
+    },
+    "shapes": [
+      {"type": "quad", "material": "white", "vertices": [[-3, 0, -3], [3, 0, -3], [3, 0, 3], [-3, 0, 3]]},
+      {"type": "sphere", "center": [-1.2, 0.4, 0], "radius": 0.4, "emission": [2, 1, 0.5]},
+      {"type": "sphere", "center": [0, 1.0, -1], "radius": 2.5, "material": "white", "flip_normals": true},
+      {"type": "disc", "center": [0.6, 1.6, 0], "normal": [0, -1, 0], "radius": 0.3, "emission": [3, 3, 3]},
+      {"type": "quad", "vertices": [[-0.4, 1.8, -0.5], [0.4, 1.8, -0.5], [0.4, 1.9, 0.3], [-0.4, 1.9, 0.3]],
+       "emission": [2, 2, 2], "two_sided": true},
+      {"type": "triangle", "vertices": [[1.2, 0.01, 0.5], [1.6, 0.01, 0.5], [1.4, 0.5, 0.4]], "emission": [1, 3, 1]},
+      {"type": "cylinder", "p0": [1.0, 0, -0.8], "p1": [1.0, 0.9, -0.8], "radius": 0.2, "material": "red"},
+      {"type": "cone", "base_center": [-0.3, 0, 0.8], "apex": [-0.3, 0.6, 0.8], "radius": 0.25, "emission": [0.5, 0.5, 2]},
+      {"type": "box", "center": [0.2, 0.25, 0.3], "size": [0.5, 0.5, 0.5], "material": "red"},
+      {"type": "sphere", "center": [-0.5, 0.3, -0.6], "radius": 0.3, "material": "black"},
+      {"type": "quad", "material": "red", "emission": [0.3, 0.3, 0.3],
+       "vertices": [[-2, 0.2, -2], [-1.5, 0.2, -2], [-1.5, 0.9, -2.2], [-2, 0.9, -2.2]]}
+    ],
+    "lights": [
+      {"type": "point", "position": [0.5, 1.5, 1.0], "intensity": [1, 1, 1]},
+      {"type": "spot", "position": [0, 1.9, 0], "direction": [0, -1, 0], "intensity": 5, "inner_deg": 15, "outer_deg": 30}
+    ]
+  })";
+  Scene scene = loadBuilt(path);  // a load error fails the test with its message
+  ASSERT_TRUE(LaneIntegrator::covers(scene, Strategy::Mis));
+  for (SamplerType sampler : {SamplerType::Sobol, SamplerType::Independent}) {
+    scene.settings.sampler = sampler;
+    const std::string name = sampler == SamplerType::Sobol ? "covered, sobol" : "covered, independent";
+    expectKernelsAgree(scene, name);
+    expectKernelsAgree(scene, name + ", one sample per pass", RenderCase{2, 16, 1, 3});
+  }
+  // Outside the set: another strategy, and a non-Lambertian material.
+  EXPECT_FALSE(LaneIntegrator::covers(scene, Strategy::Light));
+  scene.settings.strategy = Strategy::Light;
+  expectKernelsAgree(scene, "covered scene, strategy light");
+  std::filesystem::remove(path);
+  for (const char* name : {"cornell-point", "cornell-area", "textured", "gltf-mixed", "demo"})
+    EXPECT_FALSE(LaneIntegrator::covers(
+        loadSmall(test::sourcePath(std::string("scenes/") + name + ".json"), 8, 8), Strategy::Mis))
+        << name;
+  EXPECT_TRUE(LaneIntegrator::covers(loadSmall(test::sourcePath("scenes/shapes.json"), 8, 8), Strategy::Mis));
+}
+
 // More geometries than the counting sort's buckets pay for (packet/wavefront_integrator.cpp,
 // groupByGeometry sorts the wave's keys instead), many of them lights: 1,200 small spheres and
 // quads, every third one emitting, over a floor.
@@ -176,6 +236,7 @@ TEST(Wavefront, SameImageAsScalarWithThousandsOfGeometries) {
   }
   Scene scene = loadBuilt(path);  // a load error fails the test with its message
   ASSERT_GT(scene.geometryCount() + 1, WavefrontIntegrator::kMaxCountingSortBuckets);
+  ASSERT_TRUE(LaneIntegrator::covers(scene, Strategy::Mis));
   expectKernelsAgree(scene, "1,200 geometries", RenderCase{2, 16, 2, 0});
   std::filesystem::remove(path);
 }
@@ -224,8 +285,9 @@ TEST(Wavefront, SameImageForAnyThreadsTilesAndSampleRange) {
   const Film reference = renderWith(scene, Kernel::Scalar, RenderCase{1, 16, 5, 7});
   for (const RenderCase c : {RenderCase{1, 16, 5, 7}, RenderCase{2, 16, 5, 7}, RenderCase{2, 7, 5, 7},
                              RenderCase{2, 40, 5, 7}, RenderCase{1, 3, 5, 7}}) {
-    expectIdentical(reference, renderWith(scene, Kernel::Wavefront, c),
-                    "threads " + std::to_string(c.threads) + ", tile " + std::to_string(c.tileSize));
+    const std::string what = "threads " + std::to_string(c.threads) + ", tile " + std::to_string(c.tileSize);
+    expectIdentical(reference, renderWith(scene, Kernel::Wavefront, c), what);
+    expectIdentical(reference, renderWith(scene, Kernel::Lanes, c), what + ", lanes");
   }
 }
 
@@ -238,6 +300,14 @@ TEST(Wavefront, CountsTheSameRaysAsScalar) {
   EXPECT_EQ(scalar.rays, wave.rays);
   EXPECT_EQ(scalar.shadowRays, wave.shadowRays);
   EXPECT_EQ(scalar.vertices, wave.vertices);
+  const Scene shapes = loadSmall(test::sourcePath("scenes/shapes.json"), 24, 24);
+  ASSERT_TRUE(LaneIntegrator::covers(shapes, Strategy::Mis));
+  PathStats scalarShapes, lanes;
+  renderWith(shapes, Kernel::Scalar, {}, &scalarShapes);
+  renderWith(shapes, Kernel::Lanes, {}, &lanes);
+  EXPECT_EQ(scalarShapes.rays, lanes.rays);
+  EXPECT_EQ(scalarShapes.shadowRays, lanes.shadowRays);
+  EXPECT_EQ(scalarShapes.vertices, lanes.vertices);
 }
 
 // packet/geometry_groups.h: a permutation of the batch, grouped by geometry with misses first,
@@ -274,6 +344,7 @@ TEST(Wavefront, KernelNames) {
   EXPECT_EQ(parseKernel("wavefront"), Kernel::Wavefront);
   EXPECT_EQ(parseKernel("stream"), Kernel::Stream);
   EXPECT_EQ(parseKernel("scalar"), Kernel::Scalar);
+  EXPECT_EQ(parseKernel("lanes"), Kernel::Lanes);
   EXPECT_FALSE(parseKernel("packet").has_value());
 }
 

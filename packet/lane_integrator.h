@@ -1,0 +1,53 @@
+// The path tracer with the bounce's state in arrays, the structure-of-arrays design of
+// docs/architecture.md ("How the plan should land"): the wave of packet/wavefront_integrator.h,
+// whose paths in flight, vertices and light samples live in arrays indexed by path and by vertex
+// instead of per-path records, so that the bounce's steps run as vector kernels over them
+// (packet/next_event_lanes.h: next-event estimation for all vertices at once).
+//
+// It covers a closed set of scenes and grows step by step: analytic shapes with constant
+// Lambertian materials (or none), point, spot and area lights, no environment, the `mis`
+// strategy (LaneIntegrator::covers). Any other scene is rendered by the wavefront kernel. Within
+// the set every path takes PathIntegrator's steps with its own sampler, so the image equals the
+// scalar reference's bit for bit (tests/test_wavefront.cpp) and is the same for any thread count.
+#pragma once
+
+#include "packet/wavefront_integrator.h"
+
+#include <atomic>
+
+namespace ember {
+
+class LaneIntegrator final : public Integrator {
+ public:
+  static constexpr size_t kWaveSize = WavefrontIntegrator::kWaveSize;
+
+  explicit LaneIntegrator(const RenderSettings& s) : path_(s), wavefront_(path_) {}
+
+  // Whether the lane kernel renders `scene` with `strategy`; otherwise renderTile hands the tile to
+  // the wavefront kernel.
+  static bool covers(const Scene& scene, Strategy strategy);
+
+  Color Li(const Scene& scene, Ray ray, Sampler& sampler, PathStats& stats) const override {
+    return path_.Li(scene, ray, sampler, stats);
+  }
+  void renderTile(const Scene& scene, const TileWork& work, Film& film, PathStats& stats) const override;
+  bool tracesCaustics() const override { return path_.tracesCaustics(); }
+  void traceCaustics(const Scene& scene, uint64_t seed, SamplerType sampler, uint64_t firstIndex, int count,
+                     CausticSplats& splats, PathStats& stats) const override {
+    wavefront_.traceCaustics(scene, seed, sampler, firstIndex, count, splats, stats);
+  }
+  int maxDepth() const override { return path_.maxDepth(); }
+  int rrDepth() const override { return path_.rrDepth(); }
+
+ private:
+  void renderLanes(const Scene& scene, const TileWork& work, Film& film, PathStats& stats) const;
+  bool coversOnce(const Scene& scene) const;
+
+  PathIntegrator path_;
+  WavefrontIntegrator wavefront_;
+  // covers() of the last scene asked about, so that a render decides once, not per tile.
+  mutable std::atomic<const Scene*> checkedScene_{nullptr};
+  mutable std::atomic<bool> coversChecked_{false};
+};
+
+}  // namespace ember

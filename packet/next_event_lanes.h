@@ -1,0 +1,57 @@
+// Next-event estimation for a whole bounce of Lambertian vertices at once (packet/lane_integrator.h):
+// PathIntegrator::shadowFor with Lambertian::evalPdf, spawnRayTo, SurfaceHit::maskToward and the
+// power heuristic, for every vertex in Highway vectors (16 floats per AVX-512 register; the widest
+// ISA the CPU has is picked at run time). Each lane takes the scalar code's float operations in
+// their order, and the file is compiled without fused multiply-adds, so a lane's shadow ray and
+// contribution equal the scalar ones bit for bit (tests/test_wavefront.cpp).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+namespace ember {
+
+// Structure of arrays over the bounce's vertices; index v is the vertex. Lanes past the count the
+// kernel is given are computed too, up to the next multiple of kBlock: they must hold finite
+// values (the arrays start zeroed), and their results are not read.
+struct NextEventArrays {
+  static constexpr size_t kCapacity = 1024;
+  static constexpr size_t kBlock = 16;
+  // Each row is padded by a cache line: rows of exactly 4 KiB would put a vertex's fields at
+  // addresses equal in their low 12 bits, and the core, which matches loads against earlier stores
+  // by those bits first, then holds a load back behind every store to another row ("4K aliasing":
+  // writing the light samples into these rows took 17% of a render).
+  static constexpr size_t kStride = kCapacity + 16;
+  // The vertex: its point, unit geometric normal (its shading normal too: analytic shapes), the
+  // point's rounding-error bound, the direction back along the ray, the constant reflectance and
+  // the path's throughput.
+  alignas(64) float p[3][kStride] = {};
+  alignas(64) float ng[3][kStride] = {};
+  alignas(64) float pError[kStride] = {};
+  alignas(64) float wo[3][kStride] = {};
+  alignas(64) float albedo[3][kStride] = {};
+  alignas(64) float throughput[3][kStride] = {};
+  // Its light sample (LightSample at a finite distance) and the light's selection probability.
+  alignas(64) float lightP[3][kStride] = {};
+  alignas(64) float lightN[3][kStride] = {};
+  alignas(64) float lightPError[kStride] = {};
+  alignas(64) float lightWi[3][kStride] = {};
+  alignas(64) float lightLi[3][kStride] = {};
+  alignas(64) float lightPdf[kStride] = {};  // solid angle; <= 0 where the vertex has no sample
+  alignas(64) float pmf[kStride] = {};
+  alignas(64) int32_t delta[kStride] = {};  // -1: a delta light (weight 1), 0 otherwise
+  // Results: the shadow ray where `shadow` is -1, the side it leaves to (front: -1) and whether
+  // its target is clearly off the vertex's tangent plane (clear: -1; SurfaceHit::maskToward).
+  alignas(64) float origin[3][kStride] = {};
+  alignas(64) float dir[3][kStride] = {};
+  alignas(64) float tMax[kStride] = {};
+  alignas(64) float contribution[3][kStride] = {};
+  alignas(64) int32_t shadow[kStride] = {};
+  alignas(64) int32_t front[kStride] = {};
+  alignas(64) int32_t clear[kStride] = {};
+};
+
+// Computes the results of vertices [0, n).
+void nextEventLanes(NextEventArrays& a, size_t n);
+
+}  // namespace ember
