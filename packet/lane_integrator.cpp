@@ -5,6 +5,7 @@
 #include "materials/lambertian.h"
 #include "packet/next_event_lanes.h"
 #include "packet/timed_trace.h"
+#include "renderer/light_lanes.h"
 #include "renderer/sampler_lanes.h"
 
 #include <algorithm>
@@ -46,10 +47,6 @@ struct LaneWave {
   Row<const Light*> light;
   // Light queries (q), sorted by light where that makes runs: samplerIndex << 16 | vertex.
   Row<uint64_t> queryKey;
-  Row<Vec3> queryRef;
-  Row<Vec2> queryU;
-  Row<LightSample> querySample;
-  Row<bool> querySampled;
   // Sampler requests drawn together (renderer/sampler_lanes.h).
   Row<Sampler*> samplerOf;
   Row<float> drawn1D;
@@ -78,37 +75,71 @@ Vec3 load3(const float (&rows)[3][NextEventArrays::kStride], size_t v) {
   return {rows[0][v], rows[1][v], rows[2][v]};
 }
 
-// Samples every vertex's chosen light, one Light::sampleLanes call per run of one light, and
-// writes the samples into the next-event arrays (a vertex without one keeps lightPdf -1).
+void storeSample(NextEventArrays& nee, size_t v, const LightSample& ls) {
+  store3(nee.lightP, v, ls.p);
+  store3(nee.lightN, v, ls.n);
+  store3(nee.lightWi, v, ls.wi);
+  store3(nee.lightLi, v, ls.Li);
+  nee.lightPError[v] = ls.pError;
+  nee.lightPdf[v] = ls.pdf;
+  nee.delta[v] = ls.delta ? -1 : 0;
+}
+
+// AreaLight::sampleLanes for the vertices `keys` name (their low 16 bits), read from and written
+// to the next-event arrays: the same blocks of the shape's kernel, the same samples bit for bit.
+void sampleAreaLight(const AreaLight& light, const uint64_t* keys, size_t n, LaneWave& wave) {
+  NextEventArrays& nee = wave.nee;
+  SolidAngleLanes lanes{};  // shapes without a lane kernel fill only the live lanes
+  size_t vertexOf[SolidAngleLanes::kMaxLanes];
+  for (size_t next = 0; next < n;) {
+    lanes.n = 0;
+    for (; next < n && lanes.n < SolidAngleLanes::kMaxLanes; ++next) {
+      const size_t v = keys[next] & 0xffffu;
+      const Vec3 ref = load3(nee.p, v);
+      if (light.seesOnlyBack(ref)) continue;  // no sample: lightPdf stays -1
+      vertexOf[lanes.n] = v;
+      lanes.set(lanes.n++, ref, wave.drawn2D[v]);
+    }
+    if (lanes.n == 0) break;
+    lanes.padFrom(lanes.n);
+    light.shape()->sampleSolidAngleLanes(lanes);
+    LightDirectionLanes dirs;
+    lightDirectionLanes(lanes, dirs);
+    for (unsigned i = 0; i < lanes.n; ++i) {
+      if (!(lanes.pdf[i] > 0.0f && dirs.dist[i] != 0.0f)) continue;
+      const size_t v = vertexOf[i];
+      store3(nee.lightP, v, lanes.point(i));
+      store3(nee.lightN, v, lanes.normalAt(i));
+      for (int c = 0; c < 3; ++c) nee.lightWi[c][v] = dirs.wi[c][i];
+      store3(nee.lightLi, v, light.twoSided() || ((dirs.facing >> i) & 1u) ? light.radiance() : Color(0.0f));
+      nee.lightPError[v] = light.pointError();
+      nee.lightPdf[v] = lanes.pdf[i];
+      nee.delta[v] = 0;
+    }
+  }
+}
+
+// Samples every vertex's chosen light, one run of queries per light (sorted by light where that
+// makes runs; PathIntegrator's light sample), into the next-event arrays; a vertex without a
+// sample keeps lightPdf -1.
 void sampleLights(LaneWave& wave, size_t queries, size_t lights) {
   const auto keys = wave.queryKey.begin(), keysEnd = keys + ptrdiff_t(queries);
   if (lights <= LaneWave::kSize / SolidAngleLanes::kMaxLanes && !std::is_sorted(keys, keysEnd))
     std::sort(keys, keysEnd);
-  NextEventArrays& nee = wave.nee;
-  for (size_t q = 0; q < queries; ++q) {
-    const size_t v = wave.queryKey[q] & 0xffffu;
-    wave.queryRef[q] = load3(nee.p, v);
-    wave.queryU[q] = wave.drawn2D[v];
-  }
   for (size_t first = 0; first < queries;) {
     const Light* light = wave.light[wave.queryKey[first] & 0xffffu];
     size_t end = first + 1;
     while (end < queries && (wave.queryKey[end] >> 16) == (wave.queryKey[first] >> 16)) ++end;
-    light->sampleLanes(&wave.queryRef[first], &wave.queryU[first], end - first, &wave.querySample[first],
-                       &wave.querySampled[first]);
+    if (const auto* area = dynamic_cast<const AreaLight*>(light)) {
+      sampleAreaLight(*area, &wave.queryKey[first], end - first, wave);
+    } else {
+      for (size_t q = first; q < end; ++q) {
+        const size_t v = wave.queryKey[q] & 0xffffu;
+        LightSample ls;
+        if (light->sample(load3(wave.nee.p, v), wave.drawn2D[v], ls)) storeSample(wave.nee, v, ls);
+      }
+    }
     first = end;
-  }
-  for (size_t q = 0; q < queries; ++q) {
-    if (!wave.querySampled[q]) continue;
-    const size_t v = wave.queryKey[q] & 0xffffu;
-    const LightSample& ls = wave.querySample[q];
-    store3(nee.lightP, v, ls.p);
-    store3(nee.lightN, v, ls.n);
-    store3(nee.lightWi, v, ls.wi);
-    store3(nee.lightLi, v, ls.Li);
-    nee.lightPError[v] = ls.pError;
-    nee.lightPdf[v] = ls.pdf;
-    nee.delta[v] = ls.delta ? -1 : 0;
   }
 }
 
@@ -206,40 +237,49 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
         const size_t s = wave.groups.order()[o];
         RawHit raw;
         if (!wave.closest.hit(s, raw)) continue;
-        const Ray ray{wave.origin[s], wave.dir[s]};
-        SurfaceHit hit;
-        scene.surfaceHit(ray, raw, hit);
         ++stats.vertices;
-        const Vec3 wo = -ray.dir;
-        const uint16_t owner = wave.owner[s];
-        if (!isBlack(hit.emission)) {
-          // A Lambertian path never returns to a Dirac vertex: no caustic is left to the light tracer.
-          const Color emitted = hit.emitted(wo);
-          if (!isBlack(emitted)) {
-            float weight = 1.0f;
-            if (!wave.previousDelta[s]) {
-              const float lightPdf =
-                  hit.light ? lights.pmf(hit.light) * hit.light->pdf(wave.previousPoint[s], hit.p, hit.ng)
-                            : 0.0f;
-              weight = powerHeuristic(wave.previousPdf[s], lightPdf);
-            }
-            wave.radiance[owner] += wave.throughput[s] * emitted * weight;
-          }
+        // Scene::surfaceHit for an analytic shape, without the parts the scenes covered never
+        // read (texture coordinates, the shading normal, which equals ng).
+        const Scene::GeometryRecord& rec = scene.record(raw.geomID);
+        const Vec3 p0 = wave.origin[s] + raw.t * wave.dir[s];
+        const float magnitude = maxAbsComponent(p0);
+        Vec3 p = p0;
+        float pError;
+        if (raw.t > magnitude) {
+          const SurfacePoint onSurface = rec.shape->projectToSurface(p0, LocalHit{raw.t, raw.ng, raw.uv});
+          p = onSurface.p;
+          pError = onSurface.error;
+        } else {
+          pError = roundingErrorBound(magnitude + raw.t);
         }
-        if ((maxDepth >= 0 && wave.depth[s] >= maxDepth) || !hit.material || hit.material->absorbsAt(hit))
-          continue;
+        const Vec3 wo = -wave.dir[s];
+        const uint16_t owner = wave.owner[s];
+        // PathIntegrator::arrive. A Lambertian surface has no interior to attenuate, and a path
+        // that never meets a Dirac vertex leaves no caustic to the light tracer.
+        if (!isBlack(rec.emission) && (rec.twoSidedEmission || glm::dot(wo, raw.ng) > 0.0f)) {
+          float weight = 1.0f;
+          if (!wave.previousDelta[s]) {
+            const float lightPdf =
+                rec.light ? lights.pmf(rec.light) * rec.light->pdf(wave.previousPoint[s], p, raw.ng) : 0.0f;
+            weight = powerHeuristic(wave.previousPdf[s], lightPdf);
+          }
+          wave.radiance[owner] += wave.throughput[s] * rec.emission * weight;
+        }
+        if ((maxDepth >= 0 && wave.depth[s] >= maxDepth) || !rec.material) continue;
+        const Color& albedo = *static_cast<const Lambertian*>(rec.material)->constantReflectance();
+        if (isBlack(albedo)) continue;  // Material::absorbsAt
         const size_t v = vertices++;
-        store3(nee.p, v, hit.p);
-        store3(nee.ng, v, hit.ng);
-        nee.pError[v] = hit.pError;
+        store3(nee.p, v, p);
+        store3(nee.ng, v, raw.ng);
+        nee.pError[v] = pError;
         store3(nee.wo, v, wo);
-        store3(nee.albedo, v, *static_cast<const Lambertian*>(hit.material)->constantReflectance());
+        store3(nee.albedo, v, albedo);
         store3(nee.throughput, v, wave.throughput[s]);
         nee.lightPdf[v] = -1.0f;
         wave.vertexOwner[v] = owner;
         wave.vertexDepth[v] = wave.depth[s];
-        wave.maskFront[v] = hit.maskFront;
-        wave.maskBack[v] = hit.maskBack;
+        wave.maskFront[v] = rec.maskFront;
+        wave.maskBack[v] = rec.maskBack;
         wave.samplerOf[v] = &wave.samplers[owner];
       }
       phases.mark(PathPhase::Arrival);

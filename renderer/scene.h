@@ -111,7 +111,8 @@ class Scene {
   void setPacketWidth(unsigned width) { accel_->setPacketWidth(width); }
   size_t triangleCount() const;
 
- private:
+  // What surfaceHit knows of a geometry (Embree geomID) before it is hit: for loops that settle
+  // hits in their own form (packet/lane_integrator.h).
   struct GeometryRecord {
     const Shape* shape = nullptr;
     const TriangleMesh* mesh = nullptr;
@@ -124,7 +125,9 @@ class Scene {
     bool readsUv = true;              // whether the material reads the hit's texture coordinates
     uint32_t maskFront = kAllRayMask, maskBack = kAllRayMask;  // SurfaceHit's of its hits
   };
+  const GeometryRecord& record(uint32_t geomID) const { return records_[geomID]; }
 
+ private:
   std::vector<CausticCaster> findCausticCasters() const;
 
   std::unique_ptr<EmbreeAccel> accel_;
