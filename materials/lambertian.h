@@ -32,6 +32,9 @@ class Lambertian final : public Material {
   bool readsUv() const override { return !constant_; }
   // The reflectance where it is the same everywhere; null where a texture varies it.
   const Color* constantReflectance() const { return constant_ ? &constantValue_ : nullptr; }
+  // The reflectance at texture coordinates uv: what every method reads at a hit with that uv
+  // (Texture::evalAt is a function of the hit's uv alone).
+  Color reflectanceAt(Vec2 uv) const { return constant_ ? constantValue_ : reflectance_->eval(uv); }
 
  private:
   bool absorbsEverythingAt(const SurfaceHit& hit) const override { return isBlack(reflectanceAt(hit)); }

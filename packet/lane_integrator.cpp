@@ -148,8 +148,7 @@ void sampleLights(LaneWave& wave, size_t queries, size_t lights) {
 bool LaneIntegrator::covers(const Scene& scene, Strategy strategy) {
   if (strategy != Strategy::Mis || !scene.meshes.empty() || scene.environment()) return false;
   for (const Scene::ShapeEntry& entry : scene.shapes) {
-    const auto* lambertian = dynamic_cast<const Lambertian*>(entry.material);
-    if (entry.material && !(lambertian && lambertian->constantReflectance())) return false;
+    if (entry.material && !dynamic_cast<const Lambertian*>(entry.material)) return false;
   }
   // Lights at a finite distance: the next-event kernel spawns segments, not rays to infinity.
   for (const std::unique_ptr<Light>& light : scene.lights) {
@@ -239,7 +238,7 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
         if (!wave.closest.hit(s, raw)) continue;
         ++stats.vertices;
         // Scene::surfaceHit for an analytic shape, without the parts the scenes covered never
-        // read (texture coordinates, the shading normal, which equals ng).
+        // read (the shading normal equals ng; texture coordinates only for the reflectance).
         const Scene::GeometryRecord& rec = scene.record(raw.geomID);
         const Vec3 p0 = wave.origin[s] + raw.t * wave.dir[s];
         const float magnitude = maxAbsComponent(p0);
@@ -266,8 +265,12 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
           wave.radiance[owner] += wave.throughput[s] * rec.emission * weight;
         }
         if ((maxDepth >= 0 && wave.depth[s] >= maxDepth) || !rec.material) continue;
-        const Color& albedo = *static_cast<const Lambertian*>(rec.material)->constantReflectance();
-        if (isBlack(albedo)) continue;  // Material::absorbsAt
+        const auto* lambertian = static_cast<const Lambertian*>(rec.material);
+        const Color* constant = lambertian->constantReflectance();
+        const Color albedo =
+            constant ? *constant
+                     : lambertian->reflectanceAt(rec.shape->surfaceUv(LocalHit{raw.t, raw.ng, raw.uv}));
+        if (isBlack(albedo)) continue;  // Material::absorbsAt: black only where the texture may be
         const size_t v = vertices++;
         store3(nee.p, v, p);
         store3(nee.ng, v, raw.ng);
