@@ -3,6 +3,7 @@
 #include "core/sampling.h"
 #include "core/warp_lanes.h"
 #include "materials/lambertian.h"
+#include "materials/specular.h"
 #include "packet/next_event_lanes.h"
 #include "packet/timed_trace.h"
 #include "renderer/light_lanes.h"
@@ -38,13 +39,23 @@ struct LaneWave {
   Row<float> previousPdf;
   Row<bool> previousDelta;
   Row<int> depth;
+  Row<float> etaProduct;
+  Row<bool> firstBounceNonDelta;
   // Vertices: NextEventArrays holds their points, normals, errors, directions back, reflectances
   // and throughputs beside their light samples; here the rest.
   NextEventArrays nee;
   Row<uint16_t> vertexOwner;
   Row<int> vertexDepth;
+  Row<float> vertexEta;
+  Row<bool> vertexFirstNonDelta;
+  // A Dirac vertex's material (mirror, glass: no light sample) and its full hit record, which the
+  // material's scalar sample() reads; null for a Lambertian vertex.
+  Row<const Material*> dirac;
+  Row<SurfaceHit> diracHit;
   Row<uint32_t> maskFront, maskBack;
   Row<const Light*> light;
+  Row<Vec2> lightU;           // the light sample's numbers
+  Row<uint16_t> lightVertex;  // the vertices that sample a light
   // Light queries (q), sorted by light where that makes runs: samplerIndex << 16 | vertex.
   Row<uint64_t> queryKey;
   // Sampler requests drawn together (renderer/sampler_lanes.h).
@@ -98,7 +109,7 @@ void sampleAreaLight(const AreaLight& light, const uint64_t* keys, size_t n, Lan
       const Vec3 ref = load3(nee.p, v);
       if (light.seesOnlyBack(ref)) continue;  // no sample: lightPdf stays -1
       vertexOf[lanes.n] = v;
-      lanes.set(lanes.n++, ref, wave.drawn2D[v]);
+      lanes.set(lanes.n++, ref, wave.lightU[v]);
     }
     if (lanes.n == 0) break;
     lanes.padFrom(lanes.n);
@@ -136,7 +147,7 @@ void sampleLights(LaneWave& wave, size_t queries, size_t lights) {
       for (size_t q = first; q < end; ++q) {
         const size_t v = wave.queryKey[q] & 0xffffu;
         LightSample ls;
-        if (light->sample(load3(wave.nee.p, v), wave.drawn2D[v], ls)) storeSample(wave.nee, v, ls);
+        if (light->sample(load3(wave.nee.p, v), wave.lightU[v], ls)) storeSample(wave.nee, v, ls);
       }
     }
     first = end;
@@ -148,7 +159,10 @@ void sampleLights(LaneWave& wave, size_t queries, size_t lights) {
 bool LaneIntegrator::covers(const Scene& scene, Strategy strategy) {
   if (strategy != Strategy::Mis || !scene.meshes.empty() || scene.environment()) return false;
   for (const Scene::ShapeEntry& entry : scene.shapes) {
-    if (entry.material && !dynamic_cast<const Lambertian*>(entry.material)) return false;
+    const Material* m = entry.material;
+    if (m && !dynamic_cast<const Lambertian*>(m) && !dynamic_cast<const Mirror*>(m) &&
+        !dynamic_cast<const Refraction*>(m) && !dynamic_cast<const Dielectric*>(m))
+      return false;
   }
   // Lights at a finite distance: the next-event kernel spawns segments, not rays to infinity.
   for (const std::unique_ptr<Light>& light : scene.lights) {
@@ -218,6 +232,8 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
       wave.previousPdf[active] = 0.0f;
       wave.previousDelta[active] = true;
       wave.depth[active] = 1;
+      wave.etaProduct[active] = 1.0f;
+      wave.firstBounceNonDelta[active] = false;
       ++active;
       wave.closest.push(ray);
     }
@@ -231,31 +247,49 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
       // PathIntegrator::arrive for every path: its emission (no environment in the scenes
       // covered: a miss ends the path), and the vertices that scatter.
       wave.groups.group(wave.closest, active, scene.geometryCount());
-      size_t vertices = 0;
+      size_t vertices = 0, lightDraws = 0;
       for (size_t o = 0; o < active; ++o) {
         const size_t s = wave.groups.order()[o];
         RawHit raw;
         if (!wave.closest.hit(s, raw)) continue;
         ++stats.vertices;
-        // Scene::surfaceHit for an analytic shape, without the parts the scenes covered never
-        // read (the shading normal equals ng; texture coordinates only for the reflectance).
         const Scene::GeometryRecord& rec = scene.record(raw.geomID);
-        const Vec3 p0 = wave.origin[s] + raw.t * wave.dir[s];
-        const float magnitude = maxAbsComponent(p0);
-        Vec3 p = p0;
-        float pError;
-        if (raw.t > magnitude) {
-          const SurfacePoint onSurface = rec.shape->projectToSurface(p0, LocalHit{raw.t, raw.ng, raw.uv});
-          p = onSurface.p;
-          pError = onSurface.error;
-        } else {
-          pError = roundingErrorBound(magnitude + raw.t);
-        }
+        const Material* material = rec.material;
+        const bool isDirac = material && material->hasDeltaLobes();
         const Vec3 wo = -wave.dir[s];
         const uint16_t owner = wave.owner[s];
-        // PathIntegrator::arrive. A Lambertian surface has no interior to attenuate, and a path
-        // that never meets a Dirac vertex leaves no caustic to the light tracer.
-        if (!isBlack(rec.emission) && (rec.twoSidedEmission || glm::dot(wo, raw.ng) > 0.0f)) {
+        Vec3 p;
+        float pError;
+        SurfaceHit* hit = nullptr;
+        if (isDirac) {
+          // The whole record, for the material's sample(); and the medium the ray crossed.
+          hit = &wave.diracHit[vertices];
+          scene.surfaceHit(Ray{wave.origin[s], wave.dir[s]}, raw, *hit);
+          p = hit->p;
+          pError = hit->pError;
+          if (glm::dot(wave.dir[s], raw.ng) > 0.0f) {
+            wave.throughput[s] *= material->interiorTransmittance(raw.t);
+            if (isBlack(wave.throughput[s])) continue;
+          }
+        } else {
+          // Scene::surfaceHit for an analytic shape, without the parts a Lambertian vertex never
+          // reads (the shading normal equals ng; texture coordinates only for the reflectance).
+          // A Lambertian surface has no interior to attenuate.
+          const Vec3 p0 = wave.origin[s] + raw.t * wave.dir[s];
+          const float magnitude = maxAbsComponent(p0);
+          p = p0;
+          if (raw.t > magnitude) {
+            const SurfacePoint onSurface = rec.shape->projectToSurface(p0, LocalHit{raw.t, raw.ng, raw.uv});
+            p = onSurface.p;
+            pError = onSurface.error;
+          } else {
+            pError = roundingErrorBound(magnitude + raw.t);
+          }
+        }
+        // PathIntegrator::arrive's emission; a caustic path's is the light tracer's.
+        const bool caustic = path_.tracesCaustics() && wave.previousDelta[s] && wave.firstBounceNonDelta[s] &&
+                             rec.light && rec.light->causticTraced;
+        if (!isBlack(rec.emission) && (rec.twoSidedEmission || glm::dot(wo, raw.ng) > 0.0f) && !caustic) {
           float weight = 1.0f;
           if (!wave.previousDelta[s]) {
             const float lightPdf =
@@ -264,41 +298,55 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
           }
           wave.radiance[owner] += wave.throughput[s] * rec.emission * weight;
         }
-        if ((maxDepth >= 0 && wave.depth[s] >= maxDepth) || !rec.material) continue;
-        const auto* lambertian = static_cast<const Lambertian*>(rec.material);
-        const Color* constant = lambertian->constantReflectance();
-        const Color albedo =
-            constant ? *constant
-                     : lambertian->reflectanceAt(rec.shape->surfaceUv(LocalHit{raw.t, raw.ng, raw.uv}));
-        if (isBlack(albedo)) continue;  // Material::absorbsAt: black only where the texture may be
-        const size_t v = vertices++;
+        if ((maxDepth >= 0 && wave.depth[s] >= maxDepth) || !material) continue;
+        const size_t v = vertices;
+        if (isDirac) {
+          if (material->absorbsAt(*hit)) continue;
+          wave.dirac[v] = material;
+          wave.bsdfUse[v] = RequestUse{material->usesDirectionSample(), material->usesLobeSample()};
+        } else {
+          const auto* lambertian = static_cast<const Lambertian*>(material);
+          const Color* constant = lambertian->constantReflectance();
+          const Color albedo =
+              constant ? *constant
+                       : lambertian->reflectanceAt(rec.shape->surfaceUv(LocalHit{raw.t, raw.ng, raw.uv}));
+          if (isBlack(albedo)) continue;  // Material::absorbsAt: black only where the texture may be
+          store3(nee.albedo, v, albedo);
+          wave.dirac[v] = nullptr;
+          wave.bsdfUse[v] = RequestUse{true, false};  // a Lambertian reads no lobe number
+          if (!lights.empty()) wave.lightVertex[lightDraws++] = uint16_t(v);
+        }
+        ++vertices;
         store3(nee.p, v, p);
         store3(nee.ng, v, raw.ng);
         nee.pError[v] = pError;
         store3(nee.wo, v, wo);
-        store3(nee.albedo, v, albedo);
         store3(nee.throughput, v, wave.throughput[s]);
         nee.lightPdf[v] = -1.0f;
         wave.vertexOwner[v] = owner;
         wave.vertexDepth[v] = wave.depth[s];
+        wave.vertexEta[v] = wave.etaProduct[s];
+        wave.vertexFirstNonDelta[v] = wave.firstBounceNonDelta[s];
         wave.maskFront[v] = rec.maskFront;
         wave.maskBack[v] = rec.maskBack;
-        wave.samplerOf[v] = &wave.samplers[owner];
       }
       phases.mark(PathPhase::Arrival);
 
-      // The light choice (pickLight: its 1D, then its 2D request) and the lights' samples.
+      // The light choice at the Lambertian vertices (pickLight: its 1D, then its 2D request) and
+      // the lights' samples.
+      for (size_t j = 0; j < lightDraws; ++j)
+        wave.samplerOf[j] = &wave.samplers[wave.vertexOwner[wave.lightVertex[j]]];
+      draw1DThen2DLanes(wave.samplerOf.data(), lightDraws, wave.drawn1D.data(), wave.drawn2D.data(),
+                        lightUse);
       size_t queries = 0;
-      if (!lights.empty()) {
-        draw1DThen2DLanes(wave.samplerOf.data(), vertices, wave.drawn1D.data(), wave.drawn2D.data(),
-                          lightUse);
-        for (size_t v = 0; v < vertices; ++v) {
-          LightPick pick;
-          if (!PathIntegrator::pickLightWith(scene, wave.drawn1D[v], wave.drawn2D[v], pick)) continue;
-          wave.light[v] = pick.light;
-          nee.pmf[v] = pick.pmf;
-          wave.queryKey[queries++] = uint64_t(pick.light->samplerIndex) << 16 | v;
-        }
+      for (size_t j = 0; j < lightDraws; ++j) {
+        LightPick pick;
+        if (!PathIntegrator::pickLightWith(scene, wave.drawn1D[j], wave.drawn2D[j], pick)) continue;
+        const size_t v = wave.lightVertex[j];
+        wave.light[v] = pick.light;
+        wave.lightU[v] = pick.u;
+        nee.pmf[v] = pick.pmf;
+        wave.queryKey[queries++] = uint64_t(pick.light->samplerIndex) << 16 | v;
       }
       phases.mark(PathPhase::LightChoice);
       sampleLights(wave, queries, lights.size());
@@ -317,17 +365,15 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
       }
       phases.mark(PathPhase::NextEvent);
 
-      // PathIntegrator::drawBsdfSample (its 2D, then its 1D request) and Lambertian::sample.
-      for (size_t v = 0; v < vertices; ++v) {
-        wave.samplerOf[v] = &wave.samplers[wave.vertexOwner[v]];
-        wave.bsdfUse[v] = RequestUse{true, false};  // a Lambertian reads no lobe number
-      }
+      // PathIntegrator::drawBsdfSample: its 2D, then its 1D request.
+      for (size_t v = 0; v < vertices; ++v) wave.samplerOf[v] = &wave.samplers[wave.vertexOwner[v]];
       draw2DThen1DLanes(wave.samplerOf.data(), vertices, wave.drawn2D.data(), wave.drawn1D.data(),
                         wave.bsdfUse.data());
       phases.mark(PathPhase::BsdfSamples);
 
-      // Lambertian::sample in blocks of the cosine kernel, then followBsdfSample: the next ray,
-      // Russian roulette, and the survivors compacted into the slots.
+      // The BSDF samples (Lambertian::sample in blocks of the cosine kernel, a Dirac material's
+      // own sample()), then followBsdfSample: the next ray, Russian roulette, and the survivors
+      // compacted into the slots.
       wave.closest.clear();  // its hits are all read
       size_t next = 0;
       for (size_t block = 0; block < vertices; block += CosineLanes::kMaxLanes) {
@@ -340,29 +386,38 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
         sampleCosineLanes(wave.cosine, wave.cosine.padFrom(n));
         for (unsigned i = 0; i < n; ++i) {
           const size_t v = block + i;
-          const Vec3 ng = load3(nee.ng, v), wo = load3(nee.wo, v), wi = wave.cosine.direction(i);
-          const float pdf = wave.cosine.pdf[i];
-          if (pdf <= 0.0f || !(glm::dot(wo, ng) * glm::dot(wi, ng) > 0.0f)) continue;
-          Color throughput = load3(nee.throughput, v) * load3(nee.albedo, v);
+          const Vec3 ng = load3(nee.ng, v), wo = load3(nee.wo, v);
+          BsdfSample bs;
+          if (const Material* material = wave.dirac[v]) {
+            if (!material->sample(wave.diracHit[v], wo, wave.drawn2D[v], wave.drawn1D[v], bs)) continue;
+          } else {
+            bs.wi = wave.cosine.direction(i);
+            bs.pdf = wave.cosine.pdf[i];
+            if (bs.pdf <= 0.0f || !(glm::dot(wo, ng) * glm::dot(bs.wi, ng) > 0.0f)) continue;
+            bs.weight = load3(nee.albedo, v);
+          }
+          Color throughput = load3(nee.throughput, v) * bs.weight;
           if (isBlack(throughput)) continue;
           const Vec3 p = load3(nee.p, v);
-          const bool front = frontSide(ng, wi);
+          const bool front = frontSide(ng, bs.wi);
           const int depth = wave.vertexDepth[v];
+          const float eta = wave.vertexEta[v] * bs.eta;
           if (depth >= rrDepth) {
-            // Lambertian reflection leaves eta at 1, so q = min(max channel, 0.95).
-            const float q = std::min(maxComponent(throughput), 0.95f);
+            const float q = std::min(maxComponent(throughput) * eta * eta, 0.95f);
             if (wave.samplers[wave.vertexOwner[v]].get1D() >= q) continue;
             throughput /= q;
           }
-          const Ray ray{offsetAlongNormal(p, ng, nee.pError[v], front), wi};
+          const Ray ray{offsetAlongNormal(p, ng, nee.pError[v], front), bs.wi};
           wave.owner[next] = wave.vertexOwner[v];
           wave.origin[next] = ray.origin;
-          wave.dir[next] = wi;
+          wave.dir[next] = bs.wi;
           wave.throughput[next] = throughput;
           wave.previousPoint[next] = p;
-          wave.previousPdf[next] = pdf;
-          wave.previousDelta[next] = false;
+          wave.previousPdf[next] = bs.pdf;
+          wave.previousDelta[next] = bs.delta;
           wave.depth[next] = depth + 1;
+          wave.etaProduct[next] = eta;
+          wave.firstBounceNonDelta[next] = depth == 1 ? !bs.delta : wave.vertexFirstNonDelta[v];
           ++next;
           wave.closest.push(ray, front ? wave.maskFront[v] : wave.maskBack[v]);
         }

@@ -152,7 +152,8 @@ TEST(Wavefront, SameImageAsScalarForEveryEmitterAndLight) {
 }
 
 // The scenes the lane kernel covers (packet/lane_integrator.h), at the edges of its set: every
-// analytic shape, a textured material, emitters of every shape, one- and two-sided, facing in and out (a
+// analytic shape, a textured material, mirrors and glass (caustics path-traced or left to the
+// light tracer), emitters of every shape, one- and two-sided, facing in and out (a
 // sphere whose normals point inwards encloses the scene), point and spot lights, a black (absorbing)
 // material, paths cut by max depth and by Russian roulette from the second segment, both samplers, and waves
 // of one sample per pixel. The scene is then changed just outside the set, where the kernel must hand it to
@@ -169,7 +170,10 @@ TEST(LaneKernel, SameImageAsScalarOnTheScenesItCovers) {
       "red": {"type": "diffuse", "reflectance": [0.6, 0.1, 0.05]},
       "black": {"type": "diffuse", "reflectance": [0, 0, 0]},
       "checker": {"type": "diffuse", "reflectance": {"texture": ")" +
-                             checker + R"(", "filter": "bilinear"}}
+                             checker + R"(", "filter": "bilinear"}},
+      "mirror": {"type": "mirror", "reflectance": [0.9, 0.8, 0.9]},
+      "glass": {"type": "dielectric", "ior_inside": 1.5, "ior_outside": 1.0},
+      "lens": {"type": "refraction", "ior_inside": 1.3, "ior_outside": 1.0, "transmittance": [0.9, 0.95, 1.0]}
     },
     "shapes": [
       {"type": "quad", "material": "white", "vertices": [[-3, 0, -3], [3, 0, -3], [3, 0, 3], [-3, 0, 3]]},
@@ -184,7 +188,10 @@ TEST(LaneKernel, SameImageAsScalarOnTheScenesItCovers) {
       {"type": "box", "center": [0.2, 0.25, 0.3], "size": [0.5, 0.5, 0.5], "material": "checker"},
       {"type": "sphere", "center": [-0.5, 0.3, -0.6], "radius": 0.3, "material": "black"},
       {"type": "quad", "material": "red", "emission": [0.3, 0.3, 0.3],
-       "vertices": [[-2, 0.2, -2], [-1.5, 0.2, -2], [-1.5, 0.9, -2.2], [-2, 0.9, -2.2]]}
+       "vertices": [[-2, 0.2, -2], [-1.5, 0.2, -2], [-1.5, 0.9, -2.2], [-2, 0.9, -2.2]]},
+      {"type": "sphere", "center": [0.4, 0.35, -0.2], "radius": 0.3, "material": "glass"},
+      {"type": "sphere", "center": [-0.9, 1.2, -1.2], "radius": 0.35, "material": "mirror"},
+      {"type": "disc", "center": [0.9, 1.0, 0.2], "normal": [-1, 0, 0.3], "radius": 0.2, "material": "lens"}
     ],
     "lights": [
       {"type": "point", "position": [0.5, 1.5, 1.0], "intensity": [1, 1, 1]},
@@ -193,22 +200,26 @@ TEST(LaneKernel, SameImageAsScalarOnTheScenesItCovers) {
   })";
   Scene scene = loadBuilt(path);  // a load error fails the test with its message
   ASSERT_TRUE(LaneIntegrator::covers(scene, Strategy::Mis));
-  for (SamplerType sampler : {SamplerType::Sobol, SamplerType::Independent}) {
-    scene.settings.sampler = sampler;
-    const std::string name = sampler == SamplerType::Sobol ? "covered, sobol" : "covered, independent";
-    expectKernelsAgree(scene, name);
-    expectKernelsAgree(scene, name + ", one sample per pass", RenderCase{2, 16, 1, 3});
-  }
-  // Outside the set: another strategy, and a non-Lambertian material.
+  for (SamplerType sampler : {SamplerType::Sobol, SamplerType::Independent})
+    for (bool caustics : {true, false}) {
+      scene.settings.sampler = sampler;
+      scene.settings.traceCaustics = caustics;
+      const std::string name =
+          std::string(sampler == SamplerType::Sobol ? "covered, sobol" : "covered, independent") +
+          (caustics ? ", caustics traced" : ", caustics path-traced");
+      expectKernelsAgree(scene, name);
+      expectKernelsAgree(scene, name + ", one sample per pass", RenderCase{2, 16, 1, 3});
+    }
+  // Outside the set: another strategy.
   EXPECT_FALSE(LaneIntegrator::covers(scene, Strategy::Light));
   scene.settings.strategy = Strategy::Light;
   expectKernelsAgree(scene, "covered scene, strategy light");
   std::filesystem::remove(path);
-  for (const char* name : {"cornell-point", "cornell-area", "gltf-mixed", "demo"})
+  for (const char* name : {"gltf-mixed", "demo", "courtyard"})
     EXPECT_FALSE(LaneIntegrator::covers(
         loadSmall(test::sourcePath(std::string("scenes/") + name + ".json"), 8, 8), Strategy::Mis))
         << name;
-  for (const char* name : {"shapes", "textured"})
+  for (const char* name : {"cornell-point", "cornell-area", "shapes", "textured"})
     EXPECT_TRUE(LaneIntegrator::covers(
         loadSmall(test::sourcePath(std::string("scenes/") + name + ".json"), 8, 8), Strategy::Mis))
         << name;
