@@ -143,6 +143,15 @@ void sampleLights(LaneWave& wave, size_t queries, size_t lights) {
     while (end < queries && (wave.queryKey[end] >> 16) == (wave.queryKey[first] >> 16)) ++end;
     if (const auto* area = dynamic_cast<const AreaLight*>(light)) {
       sampleAreaLight(*area, &wave.queryKey[first], end - first, wave);
+    } else if (const auto* point = dynamic_cast<const PointLight*>(light)) {
+      for (size_t q = first; q < end; ++q) {  // the next-event kernel takes the sample
+        const size_t v = wave.queryKey[q] & 0xffffu;
+        store3(wave.nee.lightP, v, point->position());
+        store3(wave.nee.lightLi, v, point->intensity());
+        store3(wave.nee.lightN, v, Vec3(0.0f));
+        wave.nee.lightPError[v] = 0.0f;
+        wave.nee.pointLight[v] = -1;
+      }
     } else {
       for (size_t q = first; q < end; ++q) {
         const size_t v = wave.queryKey[q] & 0xffffu;
@@ -203,6 +212,7 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
   const LightSampler& lights = scene.lightSampler();
   const RequestUse lightUse{lights.size() > 1, lights.deltaLightCount() < lights.size()};
   const int maxDepth = path_.maxDepth(), rrDepth = path_.rrDepth();
+  const bool tracesCaustics = path_.tracesCaustics();
 
   for (uint64_t first = 0; first < total; first += LaneWave::kSize) {
     const size_t count = size_t(std::min<uint64_t>(LaneWave::kSize, total - first));
@@ -287,7 +297,7 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
           }
         }
         // PathIntegrator::arrive's emission; a caustic path's is the light tracer's.
-        const bool caustic = path_.tracesCaustics() && wave.previousDelta[s] && wave.firstBounceNonDelta[s] &&
+        const bool caustic = tracesCaustics && wave.previousDelta[s] && wave.firstBounceNonDelta[s] &&
                              rec.light && rec.light->causticTraced;
         if (!isBlack(rec.emission) && (rec.twoSidedEmission || glm::dot(wo, raw.ng) > 0.0f) && !caustic) {
           float weight = 1.0f;
@@ -323,6 +333,7 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
         store3(nee.wo, v, wo);
         store3(nee.throughput, v, wave.throughput[s]);
         nee.lightPdf[v] = -1.0f;
+        nee.pointLight[v] = 0;
         wave.vertexOwner[v] = owner;
         wave.vertexDepth[v] = wave.depth[s];
         wave.vertexEta[v] = wave.etaProduct[s];

@@ -50,7 +50,26 @@ void NextEventKernel(NextEventArrays& a, size_t n) {
     V p[3], ng[3], wo[3], albedo[3], tp[3], lp[3], ln[3], wi[3], li[3];
     load3(a.p, p), load3(a.ng, ng), load3(a.wo, wo), load3(a.albedo, albedo), load3(a.throughput, tp);
     load3(a.lightP, lp), load3(a.lightN, ln), load3(a.lightWi, wi), load3(a.lightLi, li);
-    const V pError = load(a.pError), lightPError = load(a.lightPError), lightPdf = load(a.lightPdf);
+    const V pError = load(a.pError), lightPError = load(a.lightPError);
+    V lightPdf = load(a.lightPdf);
+    const hn::RebindToSigned<D> di;
+    M delta = hn::RebindMask(d, hn::Lt(hn::Load(di, a.delta + i), hn::Zero(di)));
+
+    // A point light's sample (samplePosition): the direction and distance to its position, its
+    // intensity over the squared distance; none where the two points coincide.
+    const M point = hn::RebindMask(d, hn::Lt(hn::Load(di, a.pointLight + i), hn::Zero(di)));
+    if (!hn::AllFalse(d, point)) {
+      const V toLight[3] = {hn::Sub(lp[0], p[0]), hn::Sub(lp[1], p[1]), hn::Sub(lp[2], p[2])};
+      const V dist2 = dot3(toLight, toLight);
+      const V dist = hn::Sqrt(dist2);
+      for (int c = 0; c < 3; ++c) {
+        wi[c] = hn::IfThenElse(point, hn::Div(toLight[c], dist), wi[c]);
+        li[c] = hn::IfThenElse(point, hn::Div(li[c], dist2), li[c]);
+      }
+      lightPdf = hn::IfThenElse(point, hn::IfThenElse(hn::Eq(dist2, zero), hn::Set(d, -1.0f), hn::Set(d, 1.0f)),
+                                lightPdf);
+      delta = hn::Or(delta, point);
+    }
 
     // PathIntegrator::shadowFor: a sample with a density and some radiance.
     M ok = hn::And(hn::Not(hn::Le(lightPdf, zero)),
@@ -91,8 +110,6 @@ void NextEventKernel(NextEventArrays& a, size_t n) {
 
     // The contribution, throughput * (f * Li * (weight / lightPdf)).
     const V pdf = hn::Mul(load(a.pmf), lightPdf);
-    const hn::RebindToSigned<D> di;
-    const M delta = hn::RebindMask(d, hn::Lt(hn::Load(di, a.delta + i), hn::Zero(di)));
     const V weight = hn::IfThenElse(delta, hn::Set(d, 1.0f), powerHeuristic(d, pdf, bsdfPdf));
     const V k = hn::Div(weight, pdf);
     for (int c = 0; c < 3; ++c) {

@@ -40,6 +40,9 @@ struct NextEventArrays {
   alignas(64) float lightPdf[kStride] = {};  // solid angle; <= 0 where the vertex has no sample
   alignas(64) float pmf[kStride] = {};
   alignas(64) int32_t delta[kStride] = {};  // -1: a delta light (weight 1), 0 otherwise
+  // -1: the light is a point light at lightP with intensity lightLi, whose sample the kernel takes
+  // itself (renderer/light.cpp, samplePosition); lightWi, lightPdf and delta are then not read.
+  alignas(64) int32_t pointLight[kStride] = {};
   // Results: the shadow ray where `shadow` is -1, the side it leaves to (front: -1) and whether
   // its target is clearly off the vertex's tangent plane (clear: -1; SurfaceHit::maskToward).
   alignas(64) float origin[3][kStride] = {};

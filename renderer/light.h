@@ -58,6 +58,8 @@ class PointLight final : public Light {
   float pdf(const Vec3&, const Vec3&, const Vec3&) const override { return 0.0f; }
   Color power(float) const override { return 4.0f * kPi * intensity_; }
   bool isDelta() const override { return true; }
+  const Vec3& position() const { return position_; }
+  const Color& intensity() const { return intensity_; }
 
  private:
   Vec3 position_;
