@@ -67,7 +67,7 @@ struct BenchArgs {
   int threads = 0;
   int repeat = 3;
   std::string json;
-  std::string kernel = "wavefront";
+  std::string kernel = "lanes";
   std::string packetWidth = "auto";
   bool phases = false;
   std::string caustics;  // "trace", "path", or empty: each scene's render.caustic_tracing
@@ -201,7 +201,7 @@ Runner addBenchCommand(CLI::App& app) {
   cmd->add_option("--repeat", args->repeat, "Renders per scene; the median is reported (default 3)")
       ->check(CLI::Range(1, 1000));
   cmd->add_option("--kernel", args->kernel,
-                  "wavefront (default), stream, scalar or lanes; see `ember render --help`")
+                  "lanes (default), wavefront, stream or scalar; see `ember render --help`")
       ->check(CLI::IsMember({"wavefront", "stream", "scalar", "lanes"}));
   cmd->add_option("--packet-width", args->packetWidth,
                   "auto (default), 8 or 16 rays per packet; see `ember render --help`")

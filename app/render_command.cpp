@@ -37,7 +37,7 @@ struct RenderArgs {
   std::string sampler;
   std::string strategy;
   std::string caustics;
-  std::string kernel = "wavefront";
+  std::string kernel = "lanes";
   std::string packetWidth = "auto";
   std::string env;
   bool quiet = false;
@@ -374,9 +374,10 @@ Runner addRenderCommand(CLI::App& app) {
       ->check(CLI::IsMember({"trace", "path"}));
   cmd->add_option(
          "--kernel", args->kernel,
-         "How paths are traced, all giving the same image: wavefront (Embree packets, the default), "
-         "stream (Embree ray streams), scalar (one ray at a time, the reference) or lanes (the bounce's "
-         "state in arrays, on analytic Lambertian scenes, the wavefront elsewhere; in development)")
+         "How paths are traced, all giving the same image: lanes (the default: Embree packets, the "
+         "bounce's state in arrays and vector kernels, on the scenes it covers (`ember info` says), the "
+         "wavefront elsewhere), wavefront (Embree packets, per-path shading), stream (Embree ray "
+         "streams) or scalar (one ray at a time, the reference)")
       ->check(CLI::IsMember({"wavefront", "stream", "scalar", "lanes"}));
   cmd->add_option(
          "--packet-width", args->packetWidth,

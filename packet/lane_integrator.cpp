@@ -165,22 +165,24 @@ void sampleLights(LaneWave& wave, size_t queries, size_t lights) {
 
 }  // namespace
 
-bool LaneIntegrator::covers(const Scene& scene, Strategy strategy) {
-  if (strategy != Strategy::Mis || !scene.meshes.empty() || scene.environment()) return false;
+std::string LaneIntegrator::uncovered(const Scene& scene, Strategy strategy) {
+  if (strategy != Strategy::Mis) return "strategy " + std::string(strategyName(strategy));
+  if (!scene.meshes.empty()) return "triangle meshes";
+  if (scene.environment()) return "an environment";
   for (const Scene::ShapeEntry& entry : scene.shapes) {
     const Material* m = entry.material;
     if (m && !dynamic_cast<const Lambertian*>(m) && !dynamic_cast<const Mirror*>(m) &&
         !dynamic_cast<const Refraction*>(m) && !dynamic_cast<const Dielectric*>(m))
-      return false;
+      return "a " + std::string(m->typeName()) + " material";
   }
   // Lights at a finite distance: the next-event kernel spawns segments, not rays to infinity.
   for (const std::unique_ptr<Light>& light : scene.lights) {
     const Light* l = light.get();
     if (!dynamic_cast<const PointLight*>(l) && !dynamic_cast<const SpotLight*>(l) &&
         !dynamic_cast<const AreaLight*>(l))
-      return false;
+      return "a directional light";
   }
-  return true;
+  return "";
 }
 
 bool LaneIntegrator::coversOnce(const Scene& scene) const {

@@ -7,14 +7,16 @@
 // It covers a closed set of scenes and grows step by step: analytic shapes with Lambertian
 // materials (constant or textured), mirrors and smooth glass (Mirror, Refraction, Dielectric:
 // sampled by their scalar sample()), or none; point, spot and area lights; no environment; the
-// `mis` strategy (LaneIntegrator::covers). That holds all four shared scenes. Any other scene is rendered by the wavefront kernel. Within
-// the set every path takes PathIntegrator's steps with its own sampler, so the image equals the
-// scalar reference's bit for bit (tests/test_wavefront.cpp) and is the same for any thread count.
+// `mis` strategy (LaneIntegrator::covers). That holds all four shared scenes. Any other scene is rendered by
+// the wavefront kernel. Within the set every path takes PathIntegrator's steps with its own sampler, so the
+// image equals the scalar reference's bit for bit (tests/test_wavefront.cpp) and is the same for any thread
+// count.
 #pragma once
 
 #include "packet/wavefront_integrator.h"
 
 #include <atomic>
+#include <string>
 
 namespace ember {
 
@@ -25,8 +27,9 @@ class LaneIntegrator final : public Integrator {
   explicit LaneIntegrator(const RenderSettings& s) : path_(s), wavefront_(path_) {}
 
   // Whether the lane kernel renders `scene` with `strategy`; otherwise renderTile hands the tile to
-  // the wavefront kernel.
-  static bool covers(const Scene& scene, Strategy strategy);
+  // the wavefront kernel. uncovered says why not (`ember info`), an empty string where it does.
+  static std::string uncovered(const Scene& scene, Strategy strategy);
+  static bool covers(const Scene& scene, Strategy strategy) { return uncovered(scene, strategy).empty(); }
 
   Color Li(const Scene& scene, Ray ray, Sampler& sampler, PathStats& stats) const override {
     return path_.Li(scene, ray, sampler, stats);

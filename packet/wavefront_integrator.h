@@ -60,14 +60,14 @@ namespace ember {
 
 // How `render` and `bench` run the path tracer (--kernel). All give the same image bit for bit;
 // they differ in speed (docs/performance.md).
+//  - lanes:     LaneIntegrator (packet/lane_integrator.h), the bounce's state in arrays, where it
+//               covers the scene; the wavefront kernel elsewhere (the default);
 //  - wavefront: WavefrontIntegrator with one rtcIntersect16 / rtcOccluded16 call per packet (8
 //               where that is Embree's native width: EmbreeAccel::packetWidth);
 //  - stream:    WavefrontIntegrator handing each batch to Embree as one ray stream;
-//  - scalar:    PathIntegrator::Li, one ray at a time (the reference implementation);
-//  - lanes:     LaneIntegrator (packet/lane_integrator.h), the bounce's state in arrays, where it
-//               covers the scene; the wavefront kernel elsewhere.
+//  - scalar:    PathIntegrator::Li, one ray at a time (the reference implementation).
 enum class Kernel { Wavefront, Stream, Scalar, Lanes };
-inline constexpr const char* kKernelNames = "wavefront, stream, scalar, lanes";
+inline constexpr const char* kKernelNames = "lanes, wavefront, stream, scalar";
 std::optional<Kernel> parseKernel(std::string_view name);
 std::unique_ptr<Integrator> makeIntegrator(const RenderSettings& settings, Kernel kernel);
 
