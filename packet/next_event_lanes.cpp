@@ -66,8 +66,8 @@ void NextEventKernel(NextEventArrays& a, size_t n) {
         wi[c] = hn::IfThenElse(point, hn::Div(toLight[c], dist), wi[c]);
         li[c] = hn::IfThenElse(point, hn::Div(li[c], dist2), li[c]);
       }
-      lightPdf = hn::IfThenElse(point, hn::IfThenElse(hn::Eq(dist2, zero), hn::Set(d, -1.0f), hn::Set(d, 1.0f)),
-                                lightPdf);
+      lightPdf = hn::IfThenElse(
+          point, hn::IfThenElse(hn::Eq(dist2, zero), hn::Set(d, -1.0f), hn::Set(d, 1.0f)), lightPdf);
       delta = hn::Or(delta, point);
     }
 
