@@ -94,6 +94,7 @@ void storeSample(NextEventArrays& nee, size_t v, const LightSample& ls) {
   nee.lightPError[v] = ls.pError;
   nee.lightPdf[v] = ls.pdf;
   nee.delta[v] = ls.delta ? -1 : 0;
+  nee.infinite[v] = std::isfinite(ls.dist) ? 0 : -1;
 }
 
 // AreaLight::sampleLanes for the vertices `keys` name (their low 16 bits), read from and written
@@ -168,19 +169,11 @@ void sampleLights(LaneWave& wave, size_t queries, size_t lights) {
 std::string LaneIntegrator::uncovered(const Scene& scene, Strategy strategy) {
   if (strategy != Strategy::Mis) return "strategy " + std::string(strategyName(strategy));
   if (!scene.meshes.empty()) return "triangle meshes";
-  if (scene.environment()) return "an environment";
   for (const Scene::ShapeEntry& entry : scene.shapes) {
     const Material* m = entry.material;
     if (m && !dynamic_cast<const Lambertian*>(m) && !dynamic_cast<const Mirror*>(m) &&
         !dynamic_cast<const Refraction*>(m) && !dynamic_cast<const Dielectric*>(m))
       return "a " + std::string(m->typeName()) + " material";
-  }
-  // Lights at a finite distance: the next-event kernel spawns segments, not rays to infinity.
-  for (const std::unique_ptr<Light>& light : scene.lights) {
-    const Light* l = light.get();
-    if (!dynamic_cast<const PointLight*>(l) && !dynamic_cast<const SpotLight*>(l) &&
-        !dynamic_cast<const AreaLight*>(l))
-      return "a directional light";
   }
   return "";
 }
@@ -263,7 +256,16 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
       for (size_t o = 0; o < active; ++o) {
         const size_t s = wave.groups.order()[o];
         RawHit raw;
-        if (!wave.closest.hit(s, raw)) continue;
+        if (!wave.closest.hit(s, raw)) {
+          // PathIntegrator::onMiss: the environment the ray sees, if any; the path ends.
+          if (const EnvironmentLight* env = scene.environment()) {
+            float weight = 1.0f;
+            if (!wave.previousDelta[s])
+              weight = powerHeuristic(wave.previousPdf[s], lights.pmf(env) * env->pdfDirection(wave.dir[s]));
+            wave.radiance[wave.owner[s]] += wave.throughput[s] * env->radiance(wave.dir[s]) * weight;
+          }
+          continue;
+        }
         ++stats.vertices;
         const Scene::GeometryRecord& rec = scene.record(raw.geomID);
         const Material* material = rec.material;
@@ -336,6 +338,7 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
         store3(nee.throughput, v, wave.throughput[s]);
         nee.lightPdf[v] = -1.0f;
         nee.pointLight[v] = 0;
+        nee.infinite[v] = 0;
         wave.vertexOwner[v] = owner;
         wave.vertexDepth[v] = wave.depth[s];
         wave.vertexEta[v] = wave.etaProduct[s];

@@ -6,8 +6,9 @@
 //
 // It covers a closed set of scenes and grows step by step: analytic shapes with Lambertian
 // materials (constant or textured), mirrors and smooth glass (Mirror, Refraction, Dielectric:
-// sampled by their scalar sample()), or none; point, spot and area lights; no environment; the
-// `mis` strategy (LaneIntegrator::covers). That holds all four shared scenes. Any other scene is rendered by
+// sampled by their scalar sample()), or none; lights of every kind an analytic scene has (point,
+// spot, directional, area, the environment); the `mis` strategy (LaneIntegrator::covers). That
+// holds all four shared scenes. Any other scene is rendered by
 // the wavefront kernel. Within the set every path takes PathIntegrator's steps with its own sampler, so the
 // image equals the scalar reference's bit for bit (tests/test_wavefront.cpp) and is the same for any thread
 // count.

@@ -89,10 +89,13 @@ void NextEventKernel(NextEventArrays& a, size_t n) {
     const V f[3] = {hn::Mul(albedo[0], scale), hn::Mul(albedo[1], scale), hn::Mul(albedo[2], scale)};
     ok = hn::And(ok, hn::Not(hn::And(hn::And(hn::Eq(f[0], zero), hn::Eq(f[1], zero)), hn::Eq(f[2], zero))));
 
-    // spawnRayTo(p, ng, pError, lightP, lightN, lightPError, front).
+    // spawnRayTo(p, ng, pError, lightP, lightN, lightPError, front); towards an infinitely far
+    // light, a ray from the offset origin along wi (front: the side of wi).
+    const M infinite = hn::RebindMask(d, hn::Lt(hn::Load(di, a.infinite + i), hn::Zero(di)));
     const V dv[3] = {hn::Sub(lp[0], p[0]), hn::Sub(lp[1], p[1]), hn::Sub(lp[2], p[2])};
     const V dDotNg = dot3(dv, ng);
-    const M front = hn::Ge(dDotNg, zero);
+    const M front =
+        hn::Or(hn::And(infinite, hn::Ge(dot3(wi, ng), zero)), hn::AndNot(infinite, hn::Ge(dDotNg, zero)));
     const V offset = hn::IfThenElse(front, pError, hn::Neg(pError));
     V origin[3];
     for (int c = 0; c < 3; ++c) origin[c] = hn::Add(p[c], hn::Mul(offset, ng[c]));
@@ -103,10 +106,12 @@ void NextEventKernel(NextEventArrays& a, size_t n) {
     const V length = hn::Sqrt(dot3(segment, segment));
     const M apart = hn::Gt(length, zero);
     const V shortened = hn::Sub(length, hn::Add(lightPError, roundingErrorBound(d, length)));
-    const V tMax = hn::IfThenElseZero(hn::And(apart, hn::Lt(zero, shortened)), shortened);
-    const V dir[3] = {hn::IfThenElseZero(apart, hn::Div(segment[0], length)),
-                      hn::IfThenElseZero(apart, hn::Div(segment[1], length)),
-                      hn::IfThenElse(apart, hn::Div(segment[2], length), hn::Set(d, 1.0f))};
+    const V tMax = hn::IfThenElse(infinite, hn::Set(d, kInfinity),
+                                  hn::IfThenElseZero(hn::And(apart, hn::Lt(zero, shortened)), shortened));
+    const V dir[3] = {hn::IfThenElse(infinite, wi[0], hn::IfThenElseZero(apart, hn::Div(segment[0], length))),
+                      hn::IfThenElse(infinite, wi[1], hn::IfThenElseZero(apart, hn::Div(segment[1], length))),
+                      hn::IfThenElse(infinite, wi[2],
+                                     hn::IfThenElse(apart, hn::Div(segment[2], length), hn::Set(d, 1.0f)))};
 
     // The contribution, throughput * (f * Li * (weight / lightPdf)).
     const V pdf = hn::Mul(load(a.pmf), lightPdf);
@@ -122,8 +127,9 @@ void NextEventKernel(NextEventArrays& a, size_t n) {
     // SurfaceHit::maskToward: whether the target is off the tangent plane by more than both
     // points' errors and the dot product's rounding.
     const V sum = hn::Add(hn::Add(hn::Abs(dv[0]), hn::Abs(dv[1])), hn::Abs(dv[2]));
-    const M clear =
-        hn::Gt(hn::Abs(dDotNg), hn::Add(hn::Add(pError, lightPError), roundingErrorBound(d, sum)));
+    // Towards an infinitely far light, the surface's own mask for the side (SurfaceHit::maskFor).
+    const M clear = hn::Or(
+        infinite, hn::Gt(hn::Abs(dDotNg), hn::Add(hn::Add(pError, lightPError), roundingErrorBound(d, sum))));
     storeMask(d, ok, a.shadow + i);
     storeMask(d, front, a.front + i);
     storeMask(d, clear, a.clear + i);

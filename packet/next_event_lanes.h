@@ -43,6 +43,9 @@ struct NextEventArrays {
   // -1: the light is a point light at lightP with intensity lightLi, whose sample the kernel takes
   // itself (renderer/light.cpp, samplePosition); lightWi, lightPdf and delta are then not read.
   alignas(64) int32_t pointLight[kStride] = {};
+  // -1: the light is infinitely far (directional, environment): the shadow ray leaves in lightWi
+  // with no end (PathIntegrator::shadowFor's infinite case), and lightP and lightN are not read.
+  alignas(64) int32_t infinite[kStride] = {};
   // Results: the shadow ray where `shadow` is -1, the side it leaves to (front: -1) and whether
   // its target is clearly off the vertex's tangent plane (clear: -1; SurfaceHit::maskToward).
   alignas(64) float origin[3][kStride] = {};

@@ -161,7 +161,7 @@ TEST(Wavefront, SameImageAsScalarForEveryEmitterAndLight) {
 TEST(LaneKernel, SameImageAsScalarOnTheScenesItCovers) {
   const std::string path = (std::filesystem::temp_directory_path() / "ember_lanes_covered.json").string();
   const std::string checker = test::sourcePath("scenes/checker.png");
-  std::ofstream(path) << R"({
+  const std::string json = R"({
     "image": {"width": 29, "height": 23},
     "camera": {"origin": [0, 1.1, 1.3], "target": [0, 0.6, 0], "up": [0, 1, 0], "fov_y_deg": 50},
     "render": {"max_depth": 7, "rr_depth": 2},
@@ -170,7 +170,7 @@ TEST(LaneKernel, SameImageAsScalarOnTheScenesItCovers) {
       "red": {"type": "diffuse", "reflectance": [0.6, 0.1, 0.05]},
       "black": {"type": "diffuse", "reflectance": [0, 0, 0]},
       "checker": {"type": "diffuse", "reflectance": {"texture": ")" +
-                             checker + R"(", "filter": "bilinear"}},
+                           checker + R"(", "filter": "bilinear"}},
       "mirror": {"type": "mirror", "reflectance": [0.9, 0.8, 0.9]},
       "glass": {"type": "dielectric", "ior_inside": 1.5, "ior_outside": 1.0},
       "lens": {"type": "refraction", "ior_inside": 1.3, "ior_outside": 1.0, "transmittance": [0.9, 0.95, 1.0]}
@@ -198,6 +198,7 @@ TEST(LaneKernel, SameImageAsScalarOnTheScenesItCovers) {
       {"type": "spot", "position": [0, 1.9, 0], "direction": [0, -1, 0], "intensity": 5, "inner_deg": 15, "outer_deg": 30}
     ]
   })";
+  std::ofstream(path) << json;
   Scene scene = loadBuilt(path);  // a load error fails the test with its message
   ASSERT_TRUE(LaneIntegrator::covers(scene, Strategy::Mis));
   for (SamplerType sampler : {SamplerType::Sobol, SamplerType::Independent})
@@ -210,6 +211,30 @@ TEST(LaneKernel, SameImageAsScalarOnTheScenesItCovers) {
       expectKernelsAgree(scene, name);
       expectKernelsAgree(scene, name + ", one sample per pass", RenderCase{2, 16, 1, 3});
     }
+  // Open to the sky: without the enclosing sphere, under a sun (directional light), with a
+  // constant background and with an environment map.
+  const auto replaced = [](std::string text, const std::string& from, const std::string& to) {
+    const size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return at == std::string::npos ? text : text.replace(at, from.size(), to);
+  };
+  std::string open = replaced(
+      json,
+      R"({"type": "sphere", "center": [0, 1.0, -1], "radius": 2.5, "material": "white", "flip_normals": true},)",
+      "");
+  open = replaced(
+      open, R"("lights": [)",
+      R"("lights": [{"type": "directional", "direction": [0.3, -1, 0.2], "irradiance": [0.5, 0.5, 0.4]},)");
+  const std::string sky = test::sourcePath("scenes/gltf/sky.exr");
+  for (const std::string& variant :
+       {replaced(open, R"("rr_depth": 2})", R"("rr_depth": 2, "background": [0.3, 0.35, 0.4]})"),
+        replaced(open, R"("materials": {)", R"("environment": {"map": ")" + sky + R"("}, "materials": {)")}) {
+    std::ofstream(path) << variant;
+    Scene sunlit = loadBuilt(path);
+    ASSERT_TRUE(LaneIntegrator::covers(sunlit, Strategy::Mis));
+    ASSERT_NE(sunlit.environment(), nullptr);
+    expectKernelsAgree(sunlit, sunlit.environmentMap ? "sun and environment map" : "sun and background");
+  }
   // Outside the set: another strategy.
   EXPECT_FALSE(LaneIntegrator::covers(scene, Strategy::Light));
   scene.settings.strategy = Strategy::Light;
