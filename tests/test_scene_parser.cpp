@@ -121,8 +121,8 @@ TEST(SceneParser, MissingFileIsReported) {
 }
 
 TEST(SceneParser, SharedSceneVersionsLoad) {
-  for (const char* name :
-       {"cornell-area", "cornell-point", "shapes", "textured", "demo", "gltf-mixed", "courtyard"}) {
+  for (const char* name : {"cornell-area", "cornell-point", "shapes", "textured", "demo", "gltf-mixed",
+                           "courtyard", "terrace"}) {
     const Scene scene = loadScene(test::sourcePath(std::string("scenes/") + name + ".json"));
     EXPECT_FALSE(scene.shapes.empty()) << name;
   }

@@ -91,8 +91,8 @@ void expectKernelsAgree(Scene& scene, const std::string& name, const RenderCase&
 }
 
 TEST(Wavefront, SameImageAsScalarOnTheShippedScenes) {
-  for (const char* name :
-       {"cornell-area", "cornell-point", "shapes", "textured", "demo", "gltf-mixed", "courtyard"}) {
+  for (const char* name : {"cornell-area", "cornell-point", "shapes", "textured", "demo", "gltf-mixed",
+                           "courtyard", "terrace"}) {
     Scene scene = loadSmall(test::sourcePath(std::string("scenes/") + name + ".json"), 40, 36);
     expectKernelsAgree(scene, name);
   }
@@ -244,7 +244,7 @@ TEST(LaneKernel, SameImageAsScalarOnTheScenesItCovers) {
     EXPECT_FALSE(LaneIntegrator::covers(
         loadSmall(test::sourcePath(std::string("scenes/") + name + ".json"), 8, 8), Strategy::Mis))
         << name;
-  for (const char* name : {"cornell-point", "cornell-area", "shapes", "textured"})
+  for (const char* name : {"cornell-point", "cornell-area", "shapes", "textured", "terrace"})
     EXPECT_TRUE(LaneIntegrator::covers(
         loadSmall(test::sourcePath(std::string("scenes/") + name + ".json"), 8, 8), Strategy::Mis))
         << name;
