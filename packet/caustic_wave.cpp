@@ -4,6 +4,7 @@
 #include "packet/bsdf_batch.h"
 #include "packet/geometry_groups.h"
 #include "packet/hit_prefetch.h"
+#include "packet/thread_wave.h"
 #include "packet/timed_trace.h"
 #include "renderer/sampler_lanes.h"
 #include "renderer/scene.h"
@@ -52,12 +53,6 @@ struct LightWave {
   ShadowBatch shadows{kSize};
 };
 
-LightWave& threadLightWave() {
-  thread_local std::unique_ptr<LightWave> wave;
-  if (!wave) wave = std::make_unique<LightWave>();
-  return *wave;
-}
-
 }  // namespace
 
 void traceCausticsInWaves(const Scene& scene, int maxDepth, int rrDepth, uint64_t seed, SamplerType type,
@@ -75,7 +70,7 @@ void traceCausticsInWaves(const Scene& scene, int maxDepth, int rrDepth, uint64_
       [&](const tbb::blocked_range<uint64_t>& range) {
         _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
         _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
-        LightWave& wave = threadLightWave();
+        LightWave& wave = threadWave<LightWave>();
         wave.closest.setWidth(scene.accel().packetWidth());
         wave.shadows.setWidth(scene.accel().packetWidth());
         PathStats local;

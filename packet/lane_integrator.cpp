@@ -5,8 +5,8 @@
 #include "materials/lambertian.h"
 #include "materials/specular.h"
 #include "packet/next_event_lanes.h"
+#include "packet/thread_wave.h"
 #include "packet/timed_trace.h"
-#include "renderer/light_lanes.h"
 #include "renderer/sampler_lanes.h"
 
 #include <algorithm>
@@ -73,12 +73,6 @@ struct LaneWave {
   ShadowBatch shadows{kSize};
 };
 
-LaneWave& threadWave() {
-  thread_local std::unique_ptr<LaneWave> wave;
-  if (!wave) wave = std::make_unique<LaneWave>();
-  return *wave;
-}
-
 void store3(float (&rows)[3][NextEventArrays::kStride], size_t v, const Vec3& value) {
   rows[0][v] = value.x, rows[1][v] = value.y, rows[2][v] = value.z;
 }
@@ -98,37 +92,13 @@ void storeSample(NextEventArrays& nee, size_t v, const LightSample& ls) {
 }
 
 // AreaLight::sampleLanes for the vertices `keys` name (their low 16 bits), read from and written
-// to the next-event arrays: the same blocks of the shape's kernel, the same samples bit for bit.
-void sampleAreaLight(const AreaLight& light, const uint64_t* keys, size_t n, LaneWave& wave) {
-  NextEventArrays& nee = wave.nee;
-  SolidAngleLanes lanes{};  // shapes without a lane kernel fill only the live lanes
-  size_t vertexOf[SolidAngleLanes::kMaxLanes];
-  for (size_t next = 0; next < n;) {
-    lanes.n = 0;
-    for (; next < n && lanes.n < SolidAngleLanes::kMaxLanes; ++next) {
-      const size_t v = keys[next] & 0xffffu;
-      const Vec3 ref = load3(nee.p, v);
-      if (light.seesOnlyBack(ref)) continue;  // no sample: lightPdf stays -1
-      vertexOf[lanes.n] = v;
-      lanes.set(lanes.n++, ref, wave.lightU[v]);
-    }
-    if (lanes.n == 0) break;
-    lanes.padFrom(lanes.n);
-    light.shape()->sampleSolidAngleLanes(lanes);
-    LightDirectionLanes dirs;
-    lightDirectionLanes(lanes, dirs);
-    for (unsigned i = 0; i < lanes.n; ++i) {
-      if (!(lanes.pdf[i] > 0.0f && dirs.dist[i] != 0.0f)) continue;
-      const size_t v = vertexOf[i];
-      store3(nee.lightP, v, lanes.point(i));
-      store3(nee.lightN, v, lanes.normalAt(i));
-      for (int c = 0; c < 3; ++c) nee.lightWi[c][v] = dirs.wi[c][i];
-      store3(nee.lightLi, v, light.twoSided() || ((dirs.facing >> i) & 1u) ? light.radiance() : Color(0.0f));
-      nee.lightPError[v] = light.pointError();
-      nee.lightPdf[v] = lanes.pdf[i];
-      nee.delta[v] = 0;
-    }
-  }
+// to the next-event arrays; a vertex without a sample keeps lightPdf -1.
+void sampleAreaLight(const AreaLight& light, const uint64_t* keys, size_t n, NextEventArrays& nee,
+                     const Vec2* lightU) {
+  light.sampleBlocks(
+      n, [&](size_t q) { return load3(nee.p, keys[q] & 0xffffu); },
+      [&](size_t q) { return lightU[keys[q] & 0xffffu]; },
+      [&](size_t q, const LightSample& ls) { storeSample(nee, keys[q] & 0xffffu, ls); });
 }
 
 // Samples every vertex's chosen light, one run of queries per light (sorted by light where that
@@ -143,7 +113,7 @@ void sampleLights(LaneWave& wave, size_t queries, size_t lights) {
     size_t end = first + 1;
     while (end < queries && (wave.queryKey[end] >> 16) == (wave.queryKey[first] >> 16)) ++end;
     if (const auto* area = dynamic_cast<const AreaLight*>(light)) {
-      sampleAreaLight(*area, &wave.queryKey[first], end - first, wave);
+      sampleAreaLight(*area, &wave.queryKey[first], end - first, wave.nee, wave.lightU.data());
     } else if (const auto* point = dynamic_cast<const PointLight*>(light)) {
       for (size_t q = first; q < end; ++q) {  // the next-event kernel takes the sample
         const size_t v = wave.queryKey[q] & 0xffffu;
@@ -179,11 +149,11 @@ std::string LaneIntegrator::uncovered(const Scene& scene, Strategy strategy) {
 }
 
 bool LaneIntegrator::coversOnce(const Scene& scene) const {
-  if (checkedScene_.load(std::memory_order_acquire) != &scene) {
-    coversChecked_.store(covers(scene, path_.strategy()), std::memory_order_relaxed);
-    checkedScene_.store(&scene, std::memory_order_release);
-  }
-  return coversChecked_.load(std::memory_order_relaxed);
+  const uint64_t last = lastCovered_.load(std::memory_order_relaxed);
+  if (last >> 1 == scene.buildSerial()) return last & 1u;
+  const bool answer = covers(scene, path_.strategy());
+  lastCovered_.store(scene.buildSerial() << 1 | uint64_t(answer), std::memory_order_relaxed);
+  return answer;
 }
 
 void LaneIntegrator::renderTile(const Scene& scene, const TileWork& work, Film& film,
@@ -196,7 +166,7 @@ void LaneIntegrator::renderTile(const Scene& scene, const TileWork& work, Film& 
 
 void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film& film,
                                  PathStats& stats) const {
-  LaneWave& wave = threadWave();
+  LaneWave& wave = threadWave<LaneWave>();
   NextEventArrays& nee = wave.nee;
   wave.closest.setWidth(scene.accel().packetWidth());
   wave.shadows.setWidth(scene.accel().packetWidth());
@@ -269,7 +239,7 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
         ++stats.vertices;
         const Scene::GeometryRecord& rec = scene.record(raw.geomID);
         const Material* material = rec.material;
-        const bool isDirac = material && material->hasDeltaLobes();
+        const bool isDirac = rec.deltaLobes;
         const Vec3 wo = -wave.dir[s];
         const uint16_t owner = wave.owner[s];
         Vec3 p;
@@ -317,7 +287,6 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
         if (isDirac) {
           if (material->absorbsAt(*hit)) continue;
           wave.dirac[v] = material;
-          wave.bsdfUse[v] = RequestUse{material->usesDirectionSample(), material->usesLobeSample()};
         } else {
           const auto* lambertian = static_cast<const Lambertian*>(material);
           const Color* constant = lambertian->constantReflectance();
@@ -327,9 +296,9 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
           if (isBlack(albedo)) continue;  // Material::absorbsAt: black only where the texture may be
           store3(nee.albedo, v, albedo);
           wave.dirac[v] = nullptr;
-          wave.bsdfUse[v] = RequestUse{true, false};  // a Lambertian reads no lobe number
           if (!lights.empty()) wave.lightVertex[lightDraws++] = uint16_t(v);
         }
+        wave.bsdfUse[v] = RequestUse{material->usesDirectionSample(), material->usesLobeSample()};
         ++vertices;
         store3(nee.p, v, p);
         store3(nee.ng, v, raw.ng);

@@ -50,9 +50,10 @@ class LaneIntegrator final : public Integrator {
 
   PathIntegrator path_;
   WavefrontIntegrator wavefront_;
-  // covers() of the last scene asked about, so that a render decides once, not per tile.
-  mutable std::atomic<const Scene*> checkedScene_{nullptr};
-  mutable std::atomic<bool> coversChecked_{false};
+  // covers() of the last scene asked about, so that a render decides once, not per tile: its
+  // Scene::buildSerial() << 1 | covers, in one word so that two threads asking about two scenes
+  // never pair one scene's serial with the other's answer; 0 before the first.
+  mutable std::atomic<uint64_t> lastCovered_{0};
 };
 
 }  // namespace ember

@@ -5,6 +5,7 @@
 #include "packet/caustic_wave.h"
 #include "packet/hit_prefetch.h"
 #include "packet/lane_integrator.h"
+#include "packet/thread_wave.h"
 #include "packet/timed_trace.h"
 #include "renderer/sampler_lanes.h"
 
@@ -55,12 +56,6 @@ struct Wave {
   ShadowBatch shadows{kSize};
 };
 
-Wave& threadWave() {
-  thread_local std::unique_ptr<Wave> wave;
-  if (!wave) wave = std::make_unique<Wave>();
-  return *wave;
-}
-
 // Samples every query's light, one Light::sampleLanes call per run of queries of the same light.
 void sampleLights(Wave& wave, size_t queries, size_t lights) {
   // Sorted by light, the runs fill the lanes of the lights' kernels. Queries are made in vertex
@@ -97,7 +92,7 @@ void WavefrontIntegrator::traceCaustics(const Scene& scene, uint64_t seed, Sampl
 
 void WavefrontIntegrator::renderTile(const Scene& scene, const TileWork& work, Film& film,
                                      PathStats& stats) const {
-  Wave& wave = threadWave();
+  Wave& wave = threadWave<Wave>();
   wave.closest.setWidth(scene.accel().packetWidth());
   wave.shadows.setWidth(scene.accel().packetWidth());
   const int tileWidth = work.x1 - work.x0;

@@ -1,12 +1,11 @@
 #include "renderer/light.h"
 
-#include "renderer/light_lanes.h"
-
 #include "accel/spherical_triangle.h"
 #include "core/ray_spawn.h"
-
-#include <optional>
 #include "core/sampling.h"
+
+#include <algorithm>
+#include <optional>
 
 namespace ember {
 
@@ -83,34 +82,13 @@ bool AreaLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
 }
 
 void AreaLight::sampleLanes(const Vec3* refs, const Vec2* us, size_t n, LightSample* out, bool* ok) const {
-  SolidAngleLanes lanes{};  // shapes without a lane kernel fill only the live lanes
-  size_t query[SolidAngleLanes::kMaxLanes];
-  for (size_t next = 0; next < n;) {
-    // The next block of queries that can see the light's emitting side. The lanes are
-    // independent: a query's sample does not depend on which others share its block.
-    lanes.n = 0;
-    for (; next < n && lanes.n < SolidAngleLanes::kMaxLanes; ++next) {
-      if (seesOnlyBack(refs[next])) {
-        ok[next] = false;
-        continue;
-      }
-      query[lanes.n] = next;
-      lanes.set(lanes.n++, refs[next], us[next]);
-    }
-    if (lanes.n == 0) break;
-    lanes.padFrom(lanes.n);
-    shape_->sampleSolidAngleLanes(lanes);
-    // fromShapeSample for the block: its directions in one kernel, equal to the scalar's.
-    LightDirectionLanes dirs;
-    lightDirectionLanes(lanes, dirs);
-    for (unsigned i = 0; i < lanes.n; ++i) {
-      const size_t q = query[i];
-      ok[q] = lanes.pdf[i] > 0.0f && dirs.dist[i] != 0.0f;
-      if (ok[q])
-        fillSample({lanes.point(i), lanes.normalAt(i)}, lanes.pdf[i], dirs.dist[i],
-                   Vec3(dirs.wi[0][i], dirs.wi[1][i], dirs.wi[2][i]), (dirs.facing >> i) & 1u, out[q]);
-    }
-  }
+  std::fill(ok, ok + n, false);
+  sampleBlocks(
+      n, [&](size_t q) { return refs[q]; }, [&](size_t q) { return us[q]; },
+      [&](size_t q, const LightSample& s) {
+        ok[q] = true;
+        out[q] = s;
+      });
 }
 
 bool AreaLight::fromShapeSample(const Vec3& ref, const ShapeSample& s, float pdf, LightSample& out) const {

@@ -11,6 +11,7 @@
 #include "accel/triangle_mesh.h"
 #include "core/distribution.h"
 #include "materials/texture.h"
+#include "renderer/light_lanes.h"
 
 #include <array>
 #include <memory>
@@ -128,6 +129,11 @@ class AreaLight final : public Light {
   }
   // Blocks of the shape's sampleSolidAngleLanes.
   void sampleLanes(const Vec3* refs, const Vec2* us, size_t n, LightSample* out, bool* ok) const override;
+  // The same blocks for queries kept in the caller's own form: query q in [0, n) samples from
+  // refOf(q) with the numbers uOf(q), and sampled(q, sample) receives each query's sample, bit for
+  // bit sample()'s; a query without one (behind the light, or no sample) gets no call.
+  template <class RefOf, class UOf, class Sampled>
+  void sampleBlocks(size_t n, RefOf refOf, UOf uOf, Sampled sampled) const;
   // Lambertian emitter: Phi = pi * A * L per emitting side.
   Color power(float) const override { return (twoSided_ ? 2.0f : 1.0f) * kPi * shape_->area() * radiance_; }
   const Shape* shape() const { return shape_; }
@@ -224,5 +230,35 @@ class EnvironmentLight final : public Light {
   Distribution2D distribution_;
   float cosRot_ = 1.0f, sinRot_ = 0.0f;
 };
+
+template <class RefOf, class UOf, class Sampled>
+void AreaLight::sampleBlocks(size_t n, RefOf refOf, UOf uOf, Sampled sampled) const {
+  SolidAngleLanes lanes{};  // shapes without a lane kernel fill only the live lanes
+  size_t query[SolidAngleLanes::kMaxLanes];
+  for (size_t next = 0; next < n;) {
+    // The next block of queries that can see the light's emitting side. The lanes are
+    // independent: a query's sample does not depend on which others share its block.
+    lanes.n = 0;
+    for (; next < n && lanes.n < SolidAngleLanes::kMaxLanes; ++next) {
+      const Vec3 ref = refOf(next);
+      if (seesOnlyBack(ref)) continue;
+      query[lanes.n] = next;
+      lanes.set(lanes.n++, ref, uOf(next));
+    }
+    if (lanes.n == 0) break;
+    lanes.padFrom(lanes.n);
+    shape_->sampleSolidAngleLanes(lanes);
+    // fromShapeSample for the block: its directions in one kernel, equal to the scalar's.
+    LightDirectionLanes dirs;
+    lightDirectionLanes(lanes, dirs);
+    for (unsigned i = 0; i < lanes.n; ++i) {
+      if (!(lanes.pdf[i] > 0.0f && dirs.dist[i] != 0.0f)) continue;
+      LightSample s;
+      fillSample({lanes.point(i), lanes.normalAt(i)}, lanes.pdf[i], dirs.dist[i],
+                 Vec3(dirs.wi[0][i], dirs.wi[1][i], dirs.wi[2][i]), (dirs.facing >> i) & 1u, s);
+      sampled(query[i], s);
+    }
+  }
+}
 
 }  // namespace ember

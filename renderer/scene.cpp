@@ -3,6 +3,7 @@
 #include "accel/sphere.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 namespace ember {
@@ -45,6 +46,8 @@ void Scene::build() {
   loadedLightCount_ = lights.size();
   environment_ = nullptr;
   accel_ = std::make_unique<EmbreeAccel>();
+  static std::atomic<uint64_t> builds{0};
+  buildSerial_ = ++builds;
   records_.clear();
   meshBytes_ = 0;
   triangleLights_.clear();
@@ -74,6 +77,7 @@ void Scene::build() {
     GeometryRecord rec{entry.shape.get(), nullptr,        entry.material,
                        nullptr,           entry.emission, entry.twoSidedEmission};
     rec.readsUv = readsUv;
+    rec.deltaLobes = entry.material && entry.material->hasDeltaLobes();
     const bool flat = entry.shape->flat();
     const int convex = entry.shape->convexSide();
     rec.maskFront = flat || convex > 0 ? ~ownBit : kAllRayMask;
@@ -96,6 +100,7 @@ void Scene::build() {
     if (records_.size() <= id) records_.resize(id + 1);
     GeometryRecord rec{nullptr,        entry.mesh.get(),       entry.material,  nullptr,
                        entry.emission, entry.twoSidedEmission, entry.maps.get()};
+    rec.deltaLobes = entry.material && entry.material->hasDeltaLobes();
     if (entry.maps && entry.maps->normalMap && entry.mesh->tangents.empty()) entry.mesh->generateTangents();
     if (!isBlack(entry.emission)) {
       // Every triangle of an emissive mesh is a light of its own, chosen by power like the rest.

@@ -13,6 +13,7 @@
 #include "renderer/sampler.h"
 #include "renderer/strategy.h"
 
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -76,6 +77,9 @@ class Scene {
   // --- derived by build() -------------------------------------------------------------------
   void build();
   bool built() const { return accel_ != nullptr; }
+  // A number no other build() in this process has had (0: never built): what caches of facts
+  // derived from a built scene key on, where a scene's address could be a rebuilt or new one's.
+  uint64_t buildSerial() const { return buildSerial_; }
 
   // `mask`: the Embree ray mask (all bits, or SurfaceHit::maskFor of the surface it leaves).
   bool intersect(const Ray& ray, SurfaceHit& hit, uint32_t mask = kAllRayMask) const;
@@ -123,6 +127,7 @@ class Scene {
     const SurfaceMaps* maps = nullptr;
     int64_t firstTriangleLight = -1;  // emissive meshes: index of primitive 0's light in triangleLights_
     bool readsUv = true;              // whether the material reads the hit's texture coordinates
+    bool deltaLobes = false;          // the material's Material::hasDeltaLobes, asked once
     uint32_t maskFront = kAllRayMask, maskBack = kAllRayMask;  // SurfaceHit's of its hits
   };
   const GeometryRecord& record(uint32_t geomID) const { return records_[geomID]; }
@@ -140,6 +145,7 @@ class Scene {
   CausticTracer causticTracer_;
   Bounds bounds_;
   size_t meshBytes_ = 0;  // the meshes' indices and vertex attributes
+  uint64_t buildSerial_ = 0;
 };
 
 }  // namespace ember

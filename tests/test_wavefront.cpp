@@ -5,6 +5,8 @@
 #include "core/rng.h"
 #include "core/sampling.h"
 #include "io/scene_loader.h"
+#include "materials/phong.h"
+#include "materials/texture.h"
 #include "packet/geometry_groups.h"
 #include "packet/lane_integrator.h"
 #include "packet/wavefront_integrator.h"
@@ -158,6 +160,35 @@ TEST(Wavefront, SameImageAsScalarForEveryEmitterAndLight) {
 // material, paths cut by max depth and by Russian roulette from the second segment, both samplers, and waves
 // of one sample per pixel. The scene is then changed just outside the set, where the kernel must hand it to
 // the wavefront kernel. The camera is inside the inward-facing sphere.
+// An integrator decides once per scene whether the lane kernel covers it. A scene edited and built
+// again, at the same address, is a new scene: here one the lane kernel does not cover (a Phong
+// material), which the integrator must then hand to the wavefront kernel. (Keyed by the scene's
+// address, the decision was kept, and the lane kernel read the Phong material as a Lambertian.)
+TEST(LaneKernel, DecidesAfreshForASceneBuiltAgain) {
+  Scene scene = loadSmall(test::sourcePath("scenes/cornell-area.json"), 24, 20);
+  const std::unique_ptr<Integrator> lanes = makeIntegrator(scene.settings, Kernel::Lanes);
+  RenderOptions options;
+  options.spp = 2;
+  options.seed = scene.settings.seed;
+  options.sampler = scene.settings.sampler;
+  options.threads = 2;
+  options.tileSize = 8;
+  const auto renderLanes = [&] {
+    Film film(scene.settings.width, scene.settings.height);
+    render(scene, *lanes, options, film);
+    return film;
+  };
+  ASSERT_TRUE(LaneIntegrator::covers(scene, Strategy::Mis));
+  expectIdentical(renderWith(scene, Kernel::Scalar, {2, 8, 2}), renderLanes(), "before the edit");
+  const Material* phong = scene.addMaterial(
+      "phong", std::make_unique<Phong>(std::make_shared<ConstantTexture>(Color(0.5f)), Color(0.3f), 20.0f));
+  for (Scene::ShapeEntry& entry : scene.shapes)
+    if (entry.material) entry.material = phong;
+  scene.build();
+  ASSERT_FALSE(LaneIntegrator::covers(scene, Strategy::Mis));
+  expectIdentical(renderWith(scene, Kernel::Scalar, {2, 8, 2}), renderLanes(), "after the edit and build()");
+}
+
 TEST(LaneKernel, SameImageAsScalarOnTheScenesItCovers) {
   const std::string path = (std::filesystem::temp_directory_path() / "ember_lanes_covered.json").string();
   const std::string checker = test::sourcePath("scenes/checker.png");
