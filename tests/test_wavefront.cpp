@@ -111,6 +111,19 @@ TEST(Wavefront, SameImageAsScalarForEveryStrategyAndSampler) {
     }
 }
 
+// Emitters of every analytic shape, one- and two-sided, facing out and in (the sphere whose normals
+// point inwards encloses the scene), on a floor of material "white": the shapes the emitter tests
+// below start from, each adding its own.
+constexpr const char* kEmittersOnAFloor = R"(
+      {"type": "quad", "material": "white", "vertices": [[-3, 0, -3], [3, 0, -3], [3, 0, 3], [-3, 0, 3]]},
+      {"type": "sphere", "center": [-1.2, 0.4, 0], "radius": 0.4, "emission": [2, 1, 0.5]},
+      {"type": "sphere", "center": [0, 1.0, -1], "radius": 2.5, "material": "white", "flip_normals": true},
+      {"type": "disc", "center": [0.6, 1.6, 0], "normal": [0, -1, 0], "radius": 0.3, "emission": [3, 3, 3]},
+      {"type": "quad", "vertices": [[-0.4, 1.8, -0.5], [0.4, 1.8, -0.5], [0.4, 1.9, 0.3], [-0.4, 1.9, 0.3]],
+       "emission": [2, 2, 2], "two_sided": true},
+      {"type": "triangle", "vertices": [[1.2, 0.01, 0.5], [1.6, 0.01, 0.5], [1.4, 0.5, 0.4]], "emission": [1, 3, 1]},
+      {"type": "cone", "base_center": [-0.3, 0, 0.8], "apex": [-0.3, 0.6, 0.8], "radius": 0.25, "emission": [0.5, 0.5, 2]},)";
+
 // Emitters of every kind the scene format has, inward-facing and two-sided ones included, with
 // point, spot and directional lights and an environment, and a max depth that cuts paths.
 TEST(Wavefront, SameImageAsScalarForEveryEmitterAndLight) {
@@ -127,15 +140,9 @@ TEST(Wavefront, SameImageAsScalarForEveryEmitterAndLight) {
       "mirror": {"type": "mirror", "reflectance": [0.9, 0.9, 0.9]}
     },
     "shapes": [
-      {"type": "quad", "material": "white", "vertices": [[-3, 0, -3], [3, 0, -3], [3, 0, 3], [-3, 0, 3]]},
-      {"type": "sphere", "center": [-1.2, 0.4, 0], "radius": 0.4, "emission": [2, 1, 0.5]},
-      {"type": "sphere", "center": [0, 1.0, -1], "radius": 2.5, "material": "white", "flip_normals": true},
-      {"type": "disc", "center": [0.6, 1.6, 0], "normal": [0, -1, 0], "radius": 0.3, "emission": [3, 3, 3]},
-      {"type": "quad", "vertices": [[-0.4, 1.8, -0.5], [0.4, 1.8, -0.5], [0.4, 1.9, 0.3], [-0.4, 1.9, 0.3]],
-       "emission": [2, 2, 2], "two_sided": true},
-      {"type": "triangle", "vertices": [[1.2, 0.01, 0.5], [1.6, 0.01, 0.5], [1.4, 0.5, 0.4]], "emission": [1, 3, 1]},
+)" + std::string(kEmittersOnAFloor) +
+                             R"(
       {"type": "cylinder", "p0": [1.0, 0, -0.8], "p1": [1.0, 0.9, -0.8], "radius": 0.2, "material": "gloss"},
-      {"type": "cone", "base_center": [-0.3, 0, 0.8], "apex": [-0.3, 0.6, 0.8], "radius": 0.25, "emission": [0.5, 0.5, 2]},
       {"type": "box", "center": [0.2, 0.25, 0.3], "size": [0.5, 0.5, 0.5], "material": "glass"},
       {"type": "sphere", "center": [-0.5, 0.3, -0.6], "radius": 0.3, "material": "mirror"}
     ],
@@ -207,15 +214,9 @@ TEST(LaneKernel, SameImageAsScalarOnTheScenesItCovers) {
       "lens": {"type": "refraction", "ior_inside": 1.3, "ior_outside": 1.0, "transmittance": [0.9, 0.95, 1.0]}
     },
     "shapes": [
-      {"type": "quad", "material": "white", "vertices": [[-3, 0, -3], [3, 0, -3], [3, 0, 3], [-3, 0, 3]]},
-      {"type": "sphere", "center": [-1.2, 0.4, 0], "radius": 0.4, "emission": [2, 1, 0.5]},
-      {"type": "sphere", "center": [0, 1.0, -1], "radius": 2.5, "material": "white", "flip_normals": true},
-      {"type": "disc", "center": [0.6, 1.6, 0], "normal": [0, -1, 0], "radius": 0.3, "emission": [3, 3, 3]},
-      {"type": "quad", "vertices": [[-0.4, 1.8, -0.5], [0.4, 1.8, -0.5], [0.4, 1.9, 0.3], [-0.4, 1.9, 0.3]],
-       "emission": [2, 2, 2], "two_sided": true},
-      {"type": "triangle", "vertices": [[1.2, 0.01, 0.5], [1.6, 0.01, 0.5], [1.4, 0.5, 0.4]], "emission": [1, 3, 1]},
+)" + std::string(kEmittersOnAFloor) +
+                           R"(
       {"type": "cylinder", "p0": [1.0, 0, -0.8], "p1": [1.0, 0.9, -0.8], "radius": 0.2, "material": "red"},
-      {"type": "cone", "base_center": [-0.3, 0, 0.8], "apex": [-0.3, 0.6, 0.8], "radius": 0.25, "emission": [0.5, 0.5, 2]},
       {"type": "box", "center": [0.2, 0.25, 0.3], "size": [0.5, 0.5, 0.5], "material": "checker"},
       {"type": "sphere", "center": [-0.5, 0.3, -0.6], "radius": 0.3, "material": "black"},
       {"type": "quad", "material": "red", "emission": [0.3, 0.3, 0.3],
