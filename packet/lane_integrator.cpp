@@ -29,8 +29,9 @@ struct LaneWave {
   template <class T>
   using Row = std::array<T, kSize + 64 / sizeof(T) + 1>;
 
-  // Camera samples: the pixel, the sampler and the radiance gathered.
-  Row<int> x, y;
+  // Camera samples: the pixel, the sample's index within the tile's pass, the sampler and the
+  // radiance gathered.
+  Row<int> x, y, sample;
   std::vector<Sampler> samplers = std::vector<Sampler>(kSize, Sampler(SamplerType::Independent, 0, 0, 0));
   Row<Color> radiance;
   // Paths in flight: the ray cast and what its next vertex needs.
@@ -170,8 +171,7 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
   NextEventArrays& nee = wave.nee;
   wave.closest.setWidth(scene.accel().packetWidth());
   wave.shadows.setWidth(scene.accel().packetWidth());
-  const int tileWidth = work.x1 - work.x0;
-  const uint64_t pixels = uint64_t(tileWidth) * uint64_t(work.y1 - work.y0);
+  const uint64_t pixels = uint64_t(work.x1 - work.x0) * uint64_t(work.y1 - work.y0);
   const uint64_t total = pixels * uint64_t(work.spp);
   const uint64_t width = uint64_t(film.width());
   const LightSampler& lights = scene.lightSampler();
@@ -179,17 +179,23 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
   const int maxDepth = path_.maxDepth(), rrDepth = path_.rrDepth();
   const bool tracesCaustics = path_.tracesCaustics();
 
+  // Camera sample k of the tile is pixel k % pixels (row by row) of sample k / pixels; the wave
+  // steps through them in that order, counting instead of dividing.
+  int x = work.x0, y = work.y0, sample = 0;
   for (uint64_t first = 0; first < total; first += LaneWave::kSize) {
     const size_t count = size_t(std::min<uint64_t>(LaneWave::kSize, total - first));
     PhaseClock phases(work.timePhases, stats.phaseNanoseconds);
     for (size_t i = 0; i < count; ++i) {
-      const uint64_t k = first + i;
-      const uint64_t s = k / pixels, inTile = k % pixels;
-      wave.x[i] = work.x0 + int(inTile % uint64_t(tileWidth));
-      wave.y[i] = work.y0 + int(inTile / uint64_t(tileWidth));
-      wave.samplers[i] = Sampler(work.sampler, work.seed, uint64_t(wave.y[i]) * width + uint64_t(wave.x[i]),
-                                 work.firstSample + s);
+      wave.x[i] = x;
+      wave.y[i] = y;
+      wave.sample[i] = sample;
+      wave.samplers[i] = Sampler(work.sampler, work.seed, uint64_t(y) * width + uint64_t(x),
+                                 work.firstSample + uint64_t(sample));
       wave.samplerOf[i] = &wave.samplers[i];
+      if (++x == work.x1) {
+        x = work.x0;
+        if (++y == work.y1) y = work.y0, ++sample;
+      }
     }
     draw2DLanes(wave.samplerOf.data(), count, wave.drawn2D.data());  // the pixel jitter
     // PathIntegrator::start: paths of zero segments carry no light.
@@ -420,7 +426,7 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
     }
 
     for (size_t i = 0; i < count; ++i)
-      addToFilm(film, work, wave.x[i], wave.y[i], int((first + i) / pixels), wave.radiance[i], stats);
+      addToFilm(film, work, wave.x[i], wave.y[i], wave.sample[i], wave.radiance[i], stats);
     phases.mark(PathPhase::Camera);
   }
 }
