@@ -4,6 +4,7 @@
 #include "core/warp_lanes.h"
 #include "materials/lambertian.h"
 #include "materials/specular.h"
+#include "packet/continuation_lanes.h"
 #include "packet/next_event_lanes.h"
 #include "packet/thread_wave.h"
 #include "packet/timed_trace.h"
@@ -21,7 +22,7 @@ namespace {
 
 // One thread's wave, allocated on its first tile and reused: the bounce allocates nothing.
 // Three index spaces: camera samples (i, the wave's lanes), paths in flight (slot s, compacted
-// after every bounce) and the bounce's scattering vertices (v, in slot order).
+// after every bounce) and the bounce's scattering vertices (v, in geometry order).
 struct LaneWave {
   static constexpr size_t kSize = LaneIntegrator::kWaveSize;
   static_assert(kSize <= NextEventArrays::kCapacity);
@@ -35,25 +36,15 @@ struct LaneWave {
   std::vector<Sampler> samplers = std::vector<Sampler>(kSize, Sampler(SamplerType::Independent, 0, 0, 0));
   Row<Color> radiance;
   // Paths in flight: the ray cast and what its next vertex needs.
-  Row<uint16_t> owner;
-  Row<Vec3> origin, dir, throughput, previousPoint;
-  Row<float> previousPdf;
-  Row<bool> previousDelta;
-  Row<int> depth;
-  Row<float> etaProduct;
-  Row<bool> firstBounceNonDelta;
+  PathArrays paths;
   // Vertices: NextEventArrays holds their points, normals, errors, directions back, reflectances
-  // and throughputs beside their light samples; here the rest.
+  // and throughputs beside their light samples, ContinuationArrays their BSDF samples and paths.
   NextEventArrays nee;
-  Row<uint16_t> vertexOwner;
-  Row<int> vertexDepth;
-  Row<float> vertexEta;
-  Row<bool> vertexFirstNonDelta;
+  ContinuationArrays cont;
   // A Dirac vertex's material (mirror, glass: no light sample) and its full hit record, which the
   // material's scalar sample() reads; null for a Lambertian vertex.
   Row<const Material*> dirac;
   Row<SurfaceHit> diracHit;
-  Row<uint32_t> maskFront, maskBack;
   Row<const Light*> light;
   Row<Vec2> lightU;           // the light sample's numbers
   Row<uint16_t> lightVertex;  // the vertices that sample a light
@@ -61,11 +52,12 @@ struct LaneWave {
   Row<uint64_t> queryKey;
   // Sampler requests drawn together (renderer/sampler_lanes.h).
   Row<Sampler*> samplerOf;
-  Row<float> drawn1D;
+  Row<float> drawn1D, roulette;
   Row<Vec2> drawn2D;
   Row<RequestUse> bsdfUse;
   CosineLanes cosine;
   Row<uint16_t> shadowVertex;
+  Row<uint16_t> rouletteVertex;  // the vertices deep enough for Russian roulette
   // The bounce's hits in order of geometry: the vertices then run one shape's code at a time, and
   // their shadow rays and next rays, made in that order, fill packets with coherent rays (which
   // Embree traces 1.1-1.7x faster than rays in pixel order, measured on shapes.json).
@@ -79,6 +71,11 @@ void store3(float (&rows)[3][NextEventArrays::kStride], size_t v, const Vec3& va
 }
 Vec3 load3(const float (&rows)[3][NextEventArrays::kStride], size_t v) {
   return {rows[0][v], rows[1][v], rows[2][v]};
+}
+
+// A row triple as the pointers ClosestHitBatch::assign takes.
+std::array<const float*, 3> rowsOf(const float (&rows)[3][NextEventArrays::kStride]) {
+  return {rows[0], rows[1], rows[2]};
 }
 
 void storeSample(NextEventArrays& nee, size_t v, const LightSample& ls) {
@@ -199,25 +196,27 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
     }
     draw2DLanes(wave.samplerOf.data(), count, wave.drawn2D.data());  // the pixel jitter
     // PathIntegrator::start: paths of zero segments carry no light.
+    PathArrays& paths = wave.paths;
+    ContinuationArrays& cont = wave.cont;
     size_t active = 0;
-    wave.closest.clear();
     for (size_t i = 0; i < count; ++i) {
       wave.radiance[i] = Color(0.0f);
       if (maxDepth == 0) continue;
       const Ray ray = cameraRay(scene, wave.x[i], wave.y[i], wave.drawn2D[i]);
-      wave.owner[active] = uint16_t(i);
-      wave.origin[active] = ray.origin;
-      wave.dir[active] = ray.dir;
-      wave.throughput[active] = Color(1.0f);
-      wave.previousPoint[active] = ray.origin;
-      wave.previousPdf[active] = 0.0f;
-      wave.previousDelta[active] = true;
-      wave.depth[active] = 1;
-      wave.etaProduct[active] = 1.0f;
-      wave.firstBounceNonDelta[active] = false;
+      store3(paths.origin, active, ray.origin);
+      store3(paths.dir, active, ray.dir);
+      store3(paths.throughput, active, Color(1.0f));
+      store3(paths.previousPoint, active, ray.origin);
+      paths.previousPdf[active] = 0.0f;
+      paths.etaProduct[active] = 1.0f;
+      paths.owner[active] = int32_t(i);
+      paths.depth[active] = 1;
+      paths.previousDelta[active] = -1;
+      paths.firstBounceNonDelta[active] = 0;
+      paths.mask[active] = kAllRayMask;
       ++active;
-      wave.closest.push(ray);
     }
+    wave.closest.assign(rowsOf(paths.origin), rowsOf(paths.dir), paths.mask, active);
 
     phases.mark(PathPhase::Camera);
     while (active > 0) {
@@ -225,20 +224,24 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
       traceTimed(wave.closest, scene.accel(), BatchTraversal::Packets, stats);
       phases.mark(PathPhase::TraceClosest);
 
-      // PathIntegrator::arrive for every path: its emission (no environment in the scenes
-      // covered: a miss ends the path), and the vertices that scatter.
+      // PathIntegrator::arrive for every path: its emission, or the environment's where it left
+      // the scene, and the vertices that scatter.
       wave.groups.group(wave.closest, active, scene.geometryCount());
       size_t vertices = 0, lightDraws = 0;
       for (size_t o = 0; o < active; ++o) {
         const size_t s = wave.groups.order()[o];
+        const Vec3 dir = load3(paths.dir, s);
+        Color throughput = load3(paths.throughput, s);
+        const int32_t owner = paths.owner[s];
+        const bool previousDelta = paths.previousDelta[s] != 0;
         RawHit raw;
         if (!wave.closest.hit(s, raw)) {
           // PathIntegrator::onMiss: the environment the ray sees, if any; the path ends.
           if (const EnvironmentLight* env = scene.environment()) {
             float weight = 1.0f;
-            if (!wave.previousDelta[s])
-              weight = powerHeuristic(wave.previousPdf[s], lights.pmf(env) * env->pdfDirection(wave.dir[s]));
-            wave.radiance[wave.owner[s]] += wave.throughput[s] * env->radiance(wave.dir[s]) * weight;
+            if (!previousDelta)
+              weight = powerHeuristic(paths.previousPdf[s], lights.pmf(env) * env->pdfDirection(dir));
+            wave.radiance[owner] += throughput * env->radiance(dir) * weight;
           }
           continue;
         }
@@ -246,26 +249,26 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
         const Scene::GeometryRecord& rec = scene.record(raw.geomID);
         const Material* material = rec.material;
         const bool isDirac = rec.deltaLobes;
-        const Vec3 wo = -wave.dir[s];
-        const uint16_t owner = wave.owner[s];
+        const Vec3 origin = load3(paths.origin, s);
+        const Vec3 wo = -dir;
         Vec3 p;
         float pError;
         SurfaceHit* hit = nullptr;
         if (isDirac) {
           // The whole record, for the material's sample(); and the medium the ray crossed.
           hit = &wave.diracHit[vertices];
-          scene.surfaceHit(Ray{wave.origin[s], wave.dir[s]}, raw, *hit);
+          scene.surfaceHit(Ray{origin, dir}, raw, *hit);
           p = hit->p;
           pError = hit->pError;
-          if (glm::dot(wave.dir[s], raw.ng) > 0.0f) {
-            wave.throughput[s] *= material->interiorTransmittance(raw.t);
-            if (isBlack(wave.throughput[s])) continue;
+          if (glm::dot(dir, raw.ng) > 0.0f) {
+            throughput *= material->interiorTransmittance(raw.t);
+            if (isBlack(throughput)) continue;
           }
         } else {
           // Scene::surfaceHit for an analytic shape, without the parts a Lambertian vertex never
           // reads (the shading normal equals ng; texture coordinates only for the reflectance).
           // A Lambertian surface has no interior to attenuate.
-          const Vec3 p0 = wave.origin[s] + raw.t * wave.dir[s];
+          const Vec3 p0 = origin + raw.t * dir;
           const float magnitude = maxAbsComponent(p0);
           p = p0;
           if (raw.t > magnitude) {
@@ -277,18 +280,19 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
           }
         }
         // PathIntegrator::arrive's emission; a caustic path's is the light tracer's.
-        const bool caustic = tracesCaustics && wave.previousDelta[s] && wave.firstBounceNonDelta[s] &&
+        const bool caustic = tracesCaustics && previousDelta && paths.firstBounceNonDelta[s] != 0 &&
                              rec.light && rec.light->causticTraced;
         if (!isBlack(rec.emission) && (rec.twoSidedEmission || glm::dot(wo, raw.ng) > 0.0f) && !caustic) {
           float weight = 1.0f;
-          if (!wave.previousDelta[s]) {
+          if (!previousDelta) {
             const float lightPdf =
-                rec.light ? lights.pmf(rec.light) * rec.light->pdf(wave.previousPoint[s], p, raw.ng) : 0.0f;
-            weight = powerHeuristic(wave.previousPdf[s], lightPdf);
+                rec.light ? lights.pmf(rec.light) * rec.light->pdf(load3(paths.previousPoint, s), p, raw.ng)
+                          : 0.0f;
+            weight = powerHeuristic(paths.previousPdf[s], lightPdf);
           }
-          wave.radiance[owner] += wave.throughput[s] * rec.emission * weight;
+          wave.radiance[owner] += throughput * rec.emission * weight;
         }
-        if ((maxDepth >= 0 && wave.depth[s] >= maxDepth) || !material) continue;
+        if ((maxDepth >= 0 && paths.depth[s] >= maxDepth) || !material) continue;
         const size_t v = vertices;
         if (isDirac) {
           if (material->absorbsAt(*hit)) continue;
@@ -310,23 +314,25 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
         store3(nee.ng, v, raw.ng);
         nee.pError[v] = pError;
         store3(nee.wo, v, wo);
-        store3(nee.throughput, v, wave.throughput[s]);
+        store3(nee.throughput, v, throughput);
         nee.lightPdf[v] = -1.0f;
         nee.pointLight[v] = 0;
         nee.infinite[v] = 0;
-        wave.vertexOwner[v] = owner;
-        wave.vertexDepth[v] = wave.depth[s];
-        wave.vertexEta[v] = wave.etaProduct[s];
-        wave.vertexFirstNonDelta[v] = wave.firstBounceNonDelta[s];
-        wave.maskFront[v] = rec.maskFront;
-        wave.maskBack[v] = rec.maskBack;
+        cont.dirac[v] = isDirac ? -1 : 0;
+        cont.sampledDelta[v] = 0;
+        cont.etaProduct[v] = paths.etaProduct[s];
+        cont.owner[v] = owner;
+        cont.depth[v] = paths.depth[s];
+        cont.firstBounceNonDelta[v] = paths.firstBounceNonDelta[s];
+        cont.maskFront[v] = rec.maskFront;
+        cont.maskBack[v] = rec.maskBack;
       }
       phases.mark(PathPhase::Arrival);
 
       // The light choice at the Lambertian vertices (pickLight: its 1D, then its 2D request) and
       // the lights' samples.
       for (size_t j = 0; j < lightDraws; ++j)
-        wave.samplerOf[j] = &wave.samplers[wave.vertexOwner[wave.lightVertex[j]]];
+        wave.samplerOf[j] = &wave.samplers[size_t(cont.owner[wave.lightVertex[j]])];
       draw1DThen2DLanes(wave.samplerOf.data(), lightDraws, wave.drawn1D.data(), wave.drawn2D.data(),
                         lightUse);
       size_t queries = 0;
@@ -349,24 +355,32 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
         if (!nee.shadow[v]) continue;
         const Ray ray{load3(nee.origin, v), load3(nee.dir, v), nee.tMax[v]};
         const uint32_t surface =
-            nee.clear[v] ? (nee.front[v] ? wave.maskFront[v] : wave.maskBack[v]) : kAllRayMask;
+            nee.clear[v] ? (nee.front[v] ? cont.maskFront[v] : cont.maskBack[v]) : kAllRayMask;
         wave.shadowVertex[wave.shadows.size()] = uint16_t(v);
         wave.shadows.push(ray, surface & wave.light[v]->shadowMask);
         ++stats.shadowRays;
       }
       phases.mark(PathPhase::NextEvent);
 
-      // PathIntegrator::drawBsdfSample: its 2D, then its 1D request.
-      for (size_t v = 0; v < vertices; ++v) wave.samplerOf[v] = &wave.samplers[wave.vertexOwner[v]];
+      // PathIntegrator::drawBsdfSample: its 2D, then its 1D request; then Russian roulette's
+      // number where the path is deep enough to play. (A path that ends at this vertex draws its
+      // number too, which nothing reads: its sampler is not asked again.)
+      for (size_t v = 0; v < vertices; ++v) wave.samplerOf[v] = &wave.samplers[size_t(cont.owner[v])];
       draw2DThen1DLanes(wave.samplerOf.data(), vertices, wave.drawn2D.data(), wave.drawn1D.data(),
                         wave.bsdfUse.data());
+      size_t plays = 0;
+      for (size_t v = 0; v < vertices; ++v)
+        if (cont.depth[v] >= rrDepth) {
+          wave.samplerOf[plays] = wave.samplerOf[v];
+          wave.rouletteVertex[plays++] = uint16_t(v);
+        }
+      draw1DLanes(wave.samplerOf.data(), plays, wave.roulette.data());
+      for (size_t j = 0; j < plays; ++j) cont.roulette[wave.rouletteVertex[j]] = wave.roulette[j];
       phases.mark(PathPhase::BsdfSamples);
 
       // The BSDF samples (Lambertian::sample in blocks of the cosine kernel, a Dirac material's
-      // own sample()), then followBsdfSample: the next ray, Russian roulette, and the survivors
-      // compacted into the slots.
-      wave.closest.clear();  // its hits are all read
-      size_t next = 0;
+      // own sample()) into the continuation's rows, then followBsdfSample for all vertices in one
+      // kernel, which writes the paths that go on into the slots, and their rays as the next batch.
       for (size_t block = 0; block < vertices; block += CosineLanes::kMaxLanes) {
         const unsigned n = unsigned(std::min<size_t>(CosineLanes::kMaxLanes, vertices - block));
         for (unsigned i = 0; i < n; ++i) {
@@ -375,51 +389,34 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
           wave.cosine.set(i, glm::dot(wo, ng) >= 0.0f ? ng : -ng, wave.drawn2D[v]);
         }
         sampleCosineLanes(wave.cosine, wave.cosine.padFrom(n));
+        // Whole blocks, so that the continuation kernel's vector loads find whole stores.
+        for (int c = 0; c < 3; ++c) std::copy_n(wave.cosine.wi[c], n, &cont.wi[c][block]);
+        std::copy_n(wave.cosine.pdf, n, &cont.pdf[block]);
         for (unsigned i = 0; i < n; ++i) {
           const size_t v = block + i;
-          const Vec3 ng = load3(nee.ng, v), wo = load3(nee.wo, v);
+          const Material* material = wave.dirac[v];
+          if (!material) continue;
           BsdfSample bs;
-          if (const Material* material = wave.dirac[v]) {
-            if (!material->sample(wave.diracHit[v], wo, wave.drawn2D[v], wave.drawn1D[v], bs)) continue;
-          } else {
-            bs.wi = wave.cosine.direction(i);
-            bs.pdf = wave.cosine.pdf[i];
-            if (bs.pdf <= 0.0f || !(glm::dot(wo, ng) * glm::dot(bs.wi, ng) > 0.0f)) continue;
-            bs.weight = load3(nee.albedo, v);
-          }
-          Color throughput = load3(nee.throughput, v) * bs.weight;
-          if (isBlack(throughput)) continue;
-          const Vec3 p = load3(nee.p, v);
-          const bool front = frontSide(ng, bs.wi);
-          const int depth = wave.vertexDepth[v];
-          const float eta = wave.vertexEta[v] * bs.eta;
-          if (depth >= rrDepth) {
-            const float q = std::min(maxComponent(throughput) * eta * eta, 0.95f);
-            if (wave.samplers[wave.vertexOwner[v]].get1D() >= q) continue;
-            throughput /= q;
-          }
-          const Ray ray{offsetAlongNormal(p, ng, nee.pError[v], front), bs.wi};
-          wave.owner[next] = wave.vertexOwner[v];
-          wave.origin[next] = ray.origin;
-          wave.dir[next] = bs.wi;
-          wave.throughput[next] = throughput;
-          wave.previousPoint[next] = p;
-          wave.previousPdf[next] = bs.pdf;
-          wave.previousDelta[next] = bs.delta;
-          wave.depth[next] = depth + 1;
-          wave.etaProduct[next] = eta;
-          wave.firstBounceNonDelta[next] = depth == 1 ? !bs.delta : wave.vertexFirstNonDelta[v];
-          ++next;
-          wave.closest.push(ray, front ? wave.maskFront[v] : wave.maskBack[v]);
+          const bool sampled =
+              material->sample(wave.diracHit[v], load3(nee.wo, v), wave.drawn2D[v], wave.drawn1D[v], bs);
+          cont.diracSampled[v] = sampled ? -1 : 0;
+          if (!sampled) continue;
+          store3(cont.wi, v, bs.wi);
+          store3(cont.weight, v, bs.weight);
+          cont.pdf[v] = bs.pdf;
+          cont.eta[v] = bs.eta;
+          cont.sampledDelta[v] = bs.delta ? -1 : 0;
         }
       }
+      const size_t next = continuationLanes(nee, cont, vertices, rrDepth, paths);
+      wave.closest.assign(rowsOf(paths.origin), rowsOf(paths.dir), paths.mask, next);
       phases.mark(PathPhase::Continuation);
 
       traceTimed(wave.shadows, scene.accel(), BatchTraversal::Packets, stats);
       for (size_t j = 0; j < wave.shadows.size(); ++j) {
         if (wave.shadows.occluded(j)) continue;
         const size_t v = wave.shadowVertex[j];
-        wave.radiance[wave.vertexOwner[v]] += load3(nee.contribution, v);
+        wave.radiance[size_t(cont.owner[v])] += load3(nee.contribution, v);
       }
       active = next;
       phases.mark(PathPhase::TraceShadows);

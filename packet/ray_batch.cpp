@@ -127,6 +127,34 @@ void ClosestHitBatch::push(const Ray& ray, uint32_t mask) {
   ++size_;
 }
 
+void ClosestHitBatch::assign(const std::array<const float*, 3>& origin,
+                             const std::array<const float*, 3>& dir, const uint32_t* mask, size_t count) {
+  if (count > storage_.capacity()) throw std::logic_error("ClosestHitBatch overflow");
+  const unsigned n = storage_.width();
+  for (size_t first = 0; first < count; first += n) {
+    const size_t lanes = std::min<size_t>(n, count - first);
+    RTCRayHitN* p = packetOf(first);
+    RTCRayN* r = RTCRayHitN_RayN(p, n);
+    RTCHitN* h = RTCRayHitN_HitN(p, n);
+    const auto copy = [&](float& field, const float* row) {
+      std::memcpy(&field, row + first, lanes * sizeof(float));
+    };
+    copy(RTCRayN_org_x(r, n, 0), origin[0]);
+    copy(RTCRayN_org_y(r, n, 0), origin[1]);
+    copy(RTCRayN_org_z(r, n, 0), origin[2]);
+    copy(RTCRayN_dir_x(r, n, 0), dir[0]);
+    copy(RTCRayN_dir_y(r, n, 0), dir[1]);
+    copy(RTCRayN_dir_z(r, n, 0), dir[2]);
+    std::fill_n(&RTCRayN_tnear(r, n, 0), lanes, 0.0f);
+    std::fill_n(&RTCRayN_tfar(r, n, 0), lanes, kInfinity);
+    std::memcpy(&RTCRayN_mask(r, n, 0), mask + first, lanes * sizeof(uint32_t));
+    std::fill_n(&RTCHitN_geomID(h, n, 0), lanes, RTC_INVALID_GEOMETRY_ID);
+    std::fill_n(&RTCHitN_primID(h, n, 0), lanes, RTC_INVALID_GEOMETRY_ID);
+    std::fill_n(&RTCHitN_instID(h, n, 0, 0), lanes, RTC_INVALID_GEOMETRY_ID);
+  }
+  size_ = count;
+}
+
 void ClosestHitBatch::trace(const EmbreeAccel& accel, BatchTraversal traversal) {
   if (size_ == 0) return;
   RTCIntersectContext context;

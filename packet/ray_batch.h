@@ -14,6 +14,7 @@
 
 #include <embree3/rtcore.h>
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -71,6 +72,11 @@ class ClosestHitBatch {
   // Appends a ray (tnear 0, tfar ray.tMax); its index is the size before the call.
   // `mask`: the ray's Embree mask (all bits, or SurfaceHit::maskFor of the surface it leaves).
   void push(const Ray& ray, uint32_t mask = kAllRayMask);
+  // Replaces the batch with `count` rays kept in rows (structure of arrays): ray i from
+  // (origin[0][i], origin[1][i], origin[2][i]) along dir's, with Embree mask mask[i], as push
+  // makes it. Each field of a packet is copied from its row whole.
+  void assign(const std::array<const float*, 3>& origin, const std::array<const float*, 3>& dir,
+              const uint32_t* mask, size_t count);
   void trace(const EmbreeAccel& accel, BatchTraversal traversal = BatchTraversal::Packets);
   // The closest hit of ray i, as EmbreeAccel::intersect reports it; false if it hit nothing.
   bool hit(size_t i, RawHit& out) const;
