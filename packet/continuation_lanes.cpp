@@ -6,6 +6,8 @@
 
 #include "packet/continuation_lanes.h"
 
+#include <stdexcept>
+
 HWY_BEFORE_NAMESPACE();
 namespace ember::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
@@ -104,6 +106,8 @@ HWY_EXPORT(ContinuationKernel);
 
 size_t continuationLanes(const NextEventArrays& vertices, const ContinuationArrays& c, size_t n, int rrDepth,
                          PathArrays& next) {
+  if (n > NextEventArrays::kCapacity)
+    throw std::logic_error("continuationLanes: more vertices than the rows hold");
   return HWY_DYNAMIC_DISPATCH(ContinuationKernel)(vertices, c, n, rrDepth, next);
 }
 

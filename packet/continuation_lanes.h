@@ -16,8 +16,10 @@
 namespace ember {
 
 // The paths in flight, by slot: the ray each casts and what its next vertex needs
-// (PathIntegrator's path state). Padded as NextEventArrays: a compacted store writes whole vectors,
-// up to kBlock lanes past the last path.
+// (PathIntegrator's path state), padded as NextEventArrays. A compacted store writes a whole
+// vector, the lanes past the paths it adds holding whatever the compression left there; the next
+// store or nothing reads them. It never reaches past vertex n's block, so n <= kCapacity keeps
+// every store inside the rows.
 struct PathArrays {
   static constexpr size_t kStride = NextEventArrays::kStride;
   alignas(64) float origin[3][kStride] = {};
@@ -35,8 +37,8 @@ struct PathArrays {
 
 // The bounce's vertices' BSDF samples and path state, beside the NextEventArrays that hold their
 // points, normals, error bounds, directions back, reflectances and throughputs; index v is the
-// vertex. Lanes past the count are computed too (their results are never stored): they must
-// hold finite values, as the arrays start.
+// vertex. Lanes past the count are computed too (their results reach only the rows' lanes past
+// the paths written): they must hold finite values, as the arrays start.
 struct ContinuationArrays {
   static constexpr size_t kStride = NextEventArrays::kStride;
   // The BSDF sample's direction and density. A Lambertian vertex's come from the cosine kernel; a
@@ -62,8 +64,9 @@ struct ContinuationArrays {
   alignas(64) float roulette[kStride] = {};
 };
 
-// Follows the BSDF samples of vertices [0, n) and writes the paths that go on into slots
-// [0, returned count) of `next`, in vertex order. rrDepth: the depth from which roulette plays.
+// Follows the BSDF samples of vertices [0, n), n <= NextEventArrays::kCapacity, and writes the
+// paths that go on into slots [0, returned count) of `next`, in vertex order. rrDepth: the depth
+// from which roulette plays.
 size_t continuationLanes(const NextEventArrays& vertices, const ContinuationArrays& c, size_t n, int rrDepth,
                          PathArrays& next);
 

@@ -14,6 +14,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <numeric>
 #include <vector>
 
 namespace ember {
@@ -89,8 +90,8 @@ void storeSample(NextEventArrays& nee, size_t v, const LightSample& ls) {
   nee.infinite[v] = std::isfinite(ls.dist) ? 0 : -1;
 }
 
-// AreaLight::sampleLanes for the vertices `keys` name (their low 16 bits), read from and written
-// to the next-event arrays; a vertex without a sample keeps lightPdf -1.
+// An area light's samples (AreaLight::sampleBlocks) for the vertices `keys` name (their low 16
+// bits), read from and written to the next-event arrays; a vertex without a sample keeps lightPdf -1.
 void sampleAreaLight(const AreaLight& light, const uint64_t* keys, size_t n, NextEventArrays& nee,
                      const Vec2* lightU) {
   light.sampleBlocks(
@@ -198,24 +199,32 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
     // PathIntegrator::start: paths of zero segments carry no light.
     PathArrays& paths = wave.paths;
     ContinuationArrays& cont = wave.cont;
-    size_t active = 0;
-    for (size_t i = 0; i < count; ++i) {
-      wave.radiance[i] = Color(0.0f);
-      if (maxDepth == 0) continue;
-      const Ray ray = cameraRay(scene, wave.x[i], wave.y[i], wave.drawn2D[i]);
-      store3(paths.origin, active, ray.origin);
-      store3(paths.dir, active, ray.dir);
-      store3(paths.throughput, active, Color(1.0f));
-      store3(paths.previousPoint, active, ray.origin);
-      paths.previousPdf[active] = 0.0f;
-      paths.etaProduct[active] = 1.0f;
-      paths.owner[active] = int32_t(i);
-      paths.depth[active] = 1;
-      paths.previousDelta[active] = -1;
-      paths.firstBounceNonDelta[active] = 0;
-      paths.mask[active] = kAllRayMask;
-      ++active;
+    std::fill_n(wave.radiance.begin(), count, Color(0.0f));
+    size_t active = maxDepth == 0 ? 0 : count;  // camera sample i is slot i
+    const Camera& camera = scene.camera();
+    if (camera.perspective()) {
+      // The camera rays in lanes (Camera::generateRay's directions, bit for bit), all from its origin.
+      perspectiveDirections(camera.perspectiveFrame(), wave.x.data(), wave.y.data(), wave.drawn2D.data(),
+                            active, {paths.dir[0], paths.dir[1], paths.dir[2]});
+      for (int k = 0; k < 3; ++k) std::fill_n(paths.origin[k], active, camera.origin()[k]);
+    } else {
+      for (size_t i = 0; i < active; ++i) {
+        const Ray ray = cameraRay(scene, wave.x[i], wave.y[i], wave.drawn2D[i]);
+        store3(paths.origin, i, ray.origin);
+        store3(paths.dir, i, ray.dir);
+      }
     }
+    for (int k = 0; k < 3; ++k) {
+      std::fill_n(paths.throughput[k], active, 1.0f);
+      std::copy_n(paths.origin[k], active, paths.previousPoint[k]);
+    }
+    std::fill_n(paths.previousPdf, active, 0.0f);
+    std::fill_n(paths.etaProduct, active, 1.0f);
+    std::iota(paths.owner, paths.owner + active, 0);
+    std::fill_n(paths.depth, active, 1);
+    std::fill_n(paths.previousDelta, active, -1);  // the camera's is a Dirac "lobe"
+    std::fill_n(paths.firstBounceNonDelta, active, 0);
+    std::fill_n(paths.mask, active, kAllRayMask);
     wave.closest.assign(rowsOf(paths.origin), rowsOf(paths.dir), paths.mask, active);
 
     phases.mark(PathPhase::Camera);

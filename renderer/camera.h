@@ -6,6 +6,7 @@
 #pragma once
 
 #include "core/math.h"
+#include "renderer/camera_lanes.h"
 
 namespace ember {
 
@@ -36,6 +37,10 @@ class Camera {
   int width() const { return width_; }
   int height() const { return height_; }
   bool perspective() const { return !orthographic_; }
+  // What generateRay reads of a perspective camera (renderer/camera_lanes.h).
+  PerspectiveFrame perspectiveFrame() const {
+    return {forward_, right_, up_, scale_, aspect_, invWidth_, invHeight_};
+  }
   const Vec3& origin() const { return origin_; }
   // Area of the perspective image plane at unit distance: (2 t W/H) x (2 t).
   float imagePlaneArea() const { return 4.0f * scale_ * scale_ * aspect_; }

@@ -14,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include "simd_targets.h"
 #include "test_paths.h"
 
 #include <algorithm>
@@ -160,13 +161,20 @@ TEST(Wavefront, SameImageAsScalarForEveryEmitterAndLight) {
   std::filesystem::remove(path);
 }
 
-// The scenes the lane kernel covers (packet/lane_integrator.h), at the edges of its set: every
-// analytic shape, a textured material, mirrors and glass (caustics path-traced or left to the
-// light tracer), emitters of every shape, one- and two-sided, facing in and out (a
-// sphere whose normals point inwards encloses the scene), point and spot lights, a black (absorbing)
-// material, paths cut by max depth and by Russian roulette from the second segment, both samplers, and waves
-// of one sample per pixel. The scene is then changed just outside the set, where the kernel must hand it to
-// the wavefront kernel. The camera is inside the inward-facing sphere.
+// The lane kernel's Highway kernels (next-event estimation, the continuation's compress-and-store,
+// the camera rays, the Sobol lanes) on every SIMD target this CPU has, not only the one dynamic
+// dispatch picks: each target's compression and vector widths are different code.
+TEST(LaneKernel, SameImageAsScalarOnEverySimdTarget) {
+  for (const char* name : {"terrace", "cornell-area"}) {
+    Scene scene = loadSmall(test::sourcePath(std::string("scenes/") + name + ".json"), 21, 17);
+    ASSERT_TRUE(LaneIntegrator::covers(scene, Strategy::Mis)) << name;
+    forEachSimdTarget([&] {
+      expectIdentical(renderWith(scene, Kernel::Scalar, {2, 8, 2}),
+                      renderWith(scene, Kernel::Lanes, {2, 8, 2}), std::string(name) + ": lanes vs scalar");
+    });
+  }
+}
+
 // An integrator decides once per scene whether the lane kernel covers it. A scene edited and built
 // again, at the same address, is a new scene: here one the lane kernel does not cover (a Phong
 // material), which the integrator must then hand to the wavefront kernel. (Keyed by the scene's
@@ -196,6 +204,13 @@ TEST(LaneKernel, DecidesAfreshForASceneBuiltAgain) {
   expectIdentical(renderWith(scene, Kernel::Scalar, {2, 8, 2}), renderLanes(), "after the edit and build()");
 }
 
+// The scenes the lane kernel covers (packet/lane_integrator.h), at the edges of its set: every
+// analytic shape, a textured material, mirrors and glass (caustics path-traced or left to the
+// light tracer), emitters of every shape, one- and two-sided, facing in and out (a
+// sphere whose normals point inwards encloses the scene), point and spot lights, a black (absorbing)
+// material, paths cut by max depth and by Russian roulette from the second segment, both samplers, and waves
+// of one sample per pixel. The scene is then changed just outside the set, where the kernel must hand it to
+// the wavefront kernel. The camera is inside the inward-facing sphere.
 TEST(LaneKernel, SameImageAsScalarOnTheScenesItCovers) {
   const std::string path = (std::filesystem::temp_directory_path() / "ember_lanes_covered.json").string();
   const std::string checker = test::sourcePath("scenes/checker.png");
