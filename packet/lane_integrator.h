@@ -2,16 +2,16 @@
 // docs/architecture.md ("How the plan should land"): the wave of packet/wavefront_integrator.h,
 // whose paths in flight, vertices and light samples live in arrays indexed by path and by vertex
 // instead of per-path records, so that the bounce's steps run as vector kernels over them
-// (packet/next_event_lanes.h: next-event estimation for all vertices at once).
+// (next-event estimation, packet/next_event_lanes.h; the continuation and the compaction,
+// packet/continuation_lanes.h; the camera rays, renderer/camera_lanes.h).
 //
 // It covers a closed set of scenes and grows step by step: analytic shapes with Lambertian
 // materials (constant or textured), mirrors and smooth glass (Mirror, Refraction, Dielectric:
 // sampled by their scalar sample()), or none; lights of every kind an analytic scene has (point,
 // spot, directional, area, the environment); the `mis` strategy (LaneIntegrator::covers). That
-// holds all four shared scenes. Any other scene is rendered by
-// the wavefront kernel. Within the set every path takes PathIntegrator's steps with its own sampler, so the
-// image equals the scalar reference's bit for bit (tests/test_wavefront.cpp) and is the same for any thread
-// count.
+// holds all four shared scenes. Any other scene is rendered by the wavefront kernel. Within the
+// set every path takes PathIntegrator's steps with its own sampler, so the image equals the
+// scalar reference's bit for bit (tests/test_wavefront.cpp) and is the same for any thread count.
 #pragma once
 
 #include "packet/wavefront_integrator.h"
@@ -52,8 +52,9 @@ class LaneIntegrator final : public Integrator {
   WavefrontIntegrator wavefront_;
   // covers() of the last scene asked about, so that a render decides once, not per tile: its
   // Scene::buildSerial() << 1 | covers, in one word so that two threads asking about two scenes
-  // never pair one scene's serial with the other's answer; 0 before the first.
-  mutable std::atomic<uint64_t> lastCovered_{0};
+  // never pair one scene's serial with the other's answer. It starts as a word no serial makes
+  // (even a never-built scene's, 0).
+  mutable std::atomic<uint64_t> lastCovered_{~uint64_t(0)};
 };
 
 }  // namespace ember
