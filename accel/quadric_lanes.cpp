@@ -154,74 +154,81 @@ uint32_t BoxCrossingsKernel(const RayLanes& rays, const ExactBox& box, uint32_t 
   return hits;
 }
 
-// The texture coordinates of a block's crossings (Quad::rectangleUv and parallelogramUv, operation
-// for operation in float after the double division, so that each lane equals the scalar code).
-HWY_INLINE void rectangleUvLanes(V64 a, V64 b, const ExactAxisRectangle& rect, const Vec2* uv, float* u,
-                                 float* v, unsigned i) {
-  const D64 d;
-  const hn::Rebind<float, D64> df;
-  const auto s = hn::DemoteTo(df, hn::Div(hn::Sub(a, hn::Set(d, rect.corner[0])), hn::Set(d, rect.edge[0])));
-  const auto r = hn::DemoteTo(df, hn::Div(hn::Sub(b, hn::Set(d, rect.corner[1])), hn::Set(d, rect.edge[1])));
-  // (s, r) along v1 - v0 and v3 - v0: the half (v0, v1, v2) where s >= r, with barycentrics
-  // (s - r, r); the other (v0, v2, v3) with (s, r - s). Then uvAt: (1 - b1 - b2) uv0 + b1 uvA + b2 uvB.
-  const auto first = hn::Ge(s, r);
-  const auto b1 = hn::IfThenElse(first, hn::Sub(s, r), s);
-  const auto b2 = hn::IfThenElse(first, r, hn::Sub(r, s));
-  const auto w0 = hn::Sub(hn::Sub(hn::Set(df, 1.0f), b1), b2);
-  float* const outs[2] = {u, v};
-  for (int c = 0; c < 2; ++c) {
-    const auto uvA = hn::IfThenElse(first, hn::Set(df, uv[1][c]), hn::Set(df, uv[2][c]));
-    const auto uvB = hn::IfThenElse(first, hn::Set(df, uv[2][c]), hn::Set(df, uv[3][c]));
-    const auto sum = hn::Add(hn::Add(hn::Mul(w0, hn::Set(df, uv[0][c])), hn::Mul(b1, uvA)), hn::Mul(b2, uvB));
-    hn::StoreU(sum, df, outs[c] + i);
-  }
-}
-
-// The rectangle's test for every lane of `rays`: live where `lanes` has a bit (kLiveFromValid:
-// where the ray is valid), with each lane's t also rounded to float into tFloat when given, and
-// with uvCorners its texture coordinates into u and v.
+// The rectangle's test (AxisRectangle::cross) for every lane of `rays` in float vectors: live
+// where `lanes` has a bit (kLiveFromValid: where the ray is valid), each lane's t into tOut when
+// given, and with uvCorners its texture coordinates (Quad::rectangleUv) into u and v.
 template <bool kLiveFromValid>
-HWY_INLINE uint32_t axisRectangleLanes(const RayLanes& rays, const ExactAxisRectangle& rect, uint32_t lanes,
-                                       RectangleLanes& out, float* tFloat, const Vec2* uvCorners = nullptr,
-                                       float* u = nullptr, float* v = nullptr) {
-  const D64 d;
-  const hn::Rebind<float, D64> df;
+HWY_INLINE uint32_t axisRectangleLanes(const RayLanes& rays, const AxisRectangle& rect, uint32_t lanes,
+                                       float* tOut, const Vec2* uvCorners = nullptr, float* u = nullptr,
+                                       float* v = nullptr) {
+  const hn::CappedTag<float, RayLanes::kMaxLanes> d;
+  const hn::RebindToSigned<decltype(d)> di;
+  using VF = hn::Vec<decltype(d)>;
   const unsigned step = unsigned(hn::Lanes(d));
   const unsigned k = unsigned(rect.axis), ia = unsigned(rect.across[0]), ib = unsigned(rect.across[1]);
-  const V64 c = hn::Set(d, rect.c), zero = hn::Zero(d);
-  const V64 loA = hn::Set(d, rect.lo[0]), hiA = hn::Set(d, rect.hi[0]);
-  const V64 loB = hn::Set(d, rect.lo[1]), hiB = hn::Set(d, rect.hi[1]);
+  const VF c = hn::Set(d, rect.c), zero = hn::Zero(d), margin = hn::Set(d, AxisRectangle::kMargin);
+  const VF loA = hn::Set(d, rect.lo[0]), hiA = hn::Set(d, rect.hi[0]);
+  const VF loB = hn::Set(d, rect.lo[1]), hiB = hn::Set(d, rect.hi[1]);
   uint32_t hits = 0;
   for (unsigned i = 0; i < rays.n; i += step) {
-    const M64 live = kLiveFromValid ? validMask(d, rays, i) : blockMask(d, lanes, i);
+    auto live = hn::FirstN(d, rays.n - i);
+    if constexpr (kLiveFromValid) {
+      live = hn::And(live, hn::RebindMask(d, hn::Eq(hn::LoadU(di, rays.valid + i), hn::Set(di, -1))));
+    } else {
+      uint8_t bits[8] = {uint8_t(lanes >> i), uint8_t(lanes >> (i + 8))};
+      live = hn::And(live, hn::LoadMaskBits(d, bits));
+    }
     if (hn::AllFalse(d, live)) continue;
-    const V64 denom = loadPromoted(d, rays.dir[k], i);
-    const V64 tHit = hn::Div(hn::Sub(c, loadPromoted(d, rays.org[k], i)), denom);
-    const M64 within =
-        hn::And(hn::Gt(tHit, loadPromoted(d, rays.tnear, i)), hn::Lt(tHit, loadPromoted(d, rays.tfar, i)));
-    const V64 a = hn::Add(loadPromoted(d, rays.org[ia], i), hn::Mul(tHit, loadPromoted(d, rays.dir[ia], i)));
-    const V64 b = hn::Add(loadPromoted(d, rays.org[ib], i), hn::Mul(tHit, loadPromoted(d, rays.dir[ib], i)));
-    const M64 inside =
-        hn::And(hn::And(hn::Ge(a, loA), hn::Le(a, hiA)), hn::And(hn::Ge(b, loB), hn::Le(b, hiB)));
-    const M64 hit = hn::And(hn::And(live, hn::Ne(denom, zero)), hn::And(within, inside));
-    hn::StoreU(tHit, d, out.t + i);
-    hn::StoreU(a, d, out.a + i);
-    hn::StoreU(b, d, out.b + i);
-    if (tFloat) hn::StoreU(hn::DemoteTo(df, tHit), df, tFloat + i);
-    if (uvCorners) rectangleUvLanes(a, b, rect, uvCorners, u, v, i);
-    hits |= blockBits(d, hit, i);
+    const VF denom = hn::LoadU(d, rays.dir[k] + i);
+    const VF t = hn::Div(hn::Sub(c, hn::LoadU(d, rays.org[k] + i)), denom);
+    const auto within =
+        hn::And(hn::Gt(t, hn::LoadU(d, rays.tnear + i)), hn::Lt(t, hn::LoadU(d, rays.tfar + i)));
+    // The crossing's coordinate along one axis, and whether it lies within [lo, hi] widened by the margin.
+    const auto coordinate = [&](unsigned axis, VF lo, VF hi, VF& x) {
+      const VF o = hn::LoadU(d, rays.org[axis] + i);
+      const VF step = hn::Mul(t, hn::LoadU(d, rays.dir[axis] + i));
+      x = hn::Add(o, step);
+      const VF slack = hn::Mul(margin, hn::Add(hn::Abs(o), hn::Abs(step)));
+      return hn::And(hn::Ge(hn::Add(x, slack), lo), hn::Le(hn::Sub(x, slack), hi));
+    };
+    VF a, b;
+    const auto insideA = coordinate(ia, loA, hiA, a);
+    const auto insideB = coordinate(ib, loB, hiB, b);
+    const auto hit = hn::And(hn::And(live, hn::Ne(denom, zero)), hn::And(within, hn::And(insideA, insideB)));
+    if (tOut) hn::StoreU(t, d, tOut + i);
+    if (uvCorners) {
+      // Quad::rectangleUv: (s, r) = edgeCoordinates(a, b) along v1 - v0 and v3 - v0, the half
+      // (v0, v1, v2) where s >= r, with barycentrics (s - r, r); the other (v0, v2, v3) with
+      // (s, r - s). Then uvAt: (1 - b1 - b2) uv0 + b1 uvA + b2 uvB.
+      const VF s = hn::Div(hn::Sub(a, hn::Set(d, rect.corner[0])), hn::Set(d, rect.edge[0]));
+      const VF r = hn::Div(hn::Sub(b, hn::Set(d, rect.corner[1])), hn::Set(d, rect.edge[1]));
+      const auto first = hn::Ge(s, r);
+      const VF b1 = hn::IfThenElse(first, hn::Sub(s, r), s);
+      const VF b2 = hn::IfThenElse(first, r, hn::Sub(r, s));
+      const VF w0 = hn::Sub(hn::Sub(hn::Set(d, 1.0f), b1), b2);
+      float* const outs[2] = {u, v};
+      for (int m = 0; m < 2; ++m) {
+        const VF uvA = hn::IfThenElse(first, hn::Set(d, uvCorners[1][m]), hn::Set(d, uvCorners[2][m]));
+        const VF uvB = hn::IfThenElse(first, hn::Set(d, uvCorners[2][m]), hn::Set(d, uvCorners[3][m]));
+        const VF sum =
+            hn::Add(hn::Add(hn::Mul(w0, hn::Set(d, uvCorners[0][m])), hn::Mul(b1, uvA)), hn::Mul(b2, uvB));
+        hn::StoreU(sum, d, outs[m] + i);
+      }
+    }
+    uint8_t bits[8] = {};
+    hn::StoreMaskBits(d, hit, bits);
+    hits |= (uint32_t(bits[0]) | uint32_t(bits[1]) << 8) << i;
   }
   return hits;
 }
 
-uint32_t AxisRectangleCrossingsKernel(const RayLanes& rays, const ExactAxisRectangle& rect, uint32_t lanes,
-                                      RectangleLanes& out) {
-  return axisRectangleLanes<false>(rays, rect, lanes, out, nullptr);
+uint32_t AxisRectangleCrossingsKernel(const RayLanes& rays, const AxisRectangle& rect, uint32_t lanes) {
+  return axisRectangleLanes<false>(rays, rect, lanes, nullptr);
 }
 
-uint32_t AxisRectangleHitsKernel(const RayLanes& rays, const ExactAxisRectangle& rect, RectangleLanes& out,
-                                 float* t, const Vec2* uvCorners, float* u, float* v) {
-  return axisRectangleLanes<true>(rays, rect, 0, out, t, uvCorners, u, v);
+uint32_t AxisRectangleHitsKernel(const RayLanes& rays, const AxisRectangle& rect, float* t,
+                                 const Vec2* uvCorners, float* u, float* v) {
+  return axisRectangleLanes<true>(rays, rect, 0, t, uvCorners, u, v);
 }
 
 }  // namespace ember::HWY_NAMESPACE
@@ -325,8 +332,7 @@ bool ExactBox::cross(const Ray& ray, float tMin, float tMax, BoxCrossing& out) c
   return true;
 }
 
-bool ExactAxisRectangle::of(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Vec3& v3,
-                            ExactAxisRectangle& out) {
+bool AxisRectangle::of(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Vec3& v3, AxisRectangle& out) {
   const Vec3 e1 = v1 - v0, e2 = v3 - v0;
   for (int k = 0; k < 3; ++k) {
     if (!(v0[k] == v1[k] && v0[k] == v2[k] && v0[k] == v3[k])) continue;
@@ -342,17 +348,16 @@ bool ExactAxisRectangle::of(const Vec3& v0, const Vec3& v1, const Vec3& v2, cons
     const int second = first == p ? q : p;
     // Double adds floats of similar magnitude without rounding: v2 closes the parallelogram.
     if (glm::dvec3(v1) + glm::dvec3(v3) - glm::dvec3(v0) != glm::dvec3(v2)) return false;
-    ExactAxisRectangle r;
+    AxisRectangle r;
     r.axis = k;
     r.across[0] = first;
     r.across[1] = second;
-    r.c = double(v0[k]);
-    r.corner[0] = double(v0[first]);
-    r.corner[1] = double(v0[second]);
-    r.edge[0] = double(v1[first]) - double(v0[first]);
-    r.edge[1] = double(v3[second]) - double(v0[second]);
-    const double ends[2][2] = {{double(v0[first]), double(v1[first])},
-                               {double(v0[second]), double(v3[second])}};
+    r.c = v0[k];
+    r.corner[0] = v0[first];
+    r.corner[1] = v0[second];
+    r.edge[0] = e1[first];
+    r.edge[1] = e2[second];
+    const float ends[2][2] = {{v0[first], v1[first]}, {v0[second], v3[second]}};
     for (int j = 0; j < 2; ++j) {
       r.lo[j] = std::min(ends[j][0], ends[j][1]);
       r.hi[j] = std::max(ends[j][0], ends[j][1]);
@@ -365,26 +370,33 @@ bool ExactAxisRectangle::of(const Vec3& v0, const Vec3& v1, const Vec3& v2, cons
   return false;
 }
 
-bool ExactAxisRectangle::cross(const Ray& ray, float tMin, float tMax, RectangleCrossing& out) const {
-  const double denom = double(ray.dir[axis]);
-  if (denom == 0.0) return false;  // parallel: a zero-thickness rectangle is never hit edge-on
-  const double tHit = (c - double(ray.origin[axis])) / denom;
-  if (!(tHit > tMin && tHit < tMax)) return false;
-  const double a = double(ray.origin[across[0]]) + tHit * double(ray.dir[across[0]]);
-  const double b = double(ray.origin[across[1]]) + tHit * double(ray.dir[across[1]]);
-  if (!(a >= lo[0] && a <= hi[0] && b >= lo[1] && b <= hi[1])) return false;
-  out = {tHit, a, b};
+bool AxisRectangle::cross(const Ray& ray, float tMin, float tMax, RectangleCrossing& out) const {
+  const float denom = ray.dir[axis];
+  if (denom == 0.0f) return false;  // parallel: a zero-thickness rectangle is never hit edge-on
+  const float t = (c - ray.origin[axis]) / denom;
+  if (!(t > tMin && t < tMax)) return false;
+  // The crossing's coordinates, each against its bounds widened by the margin (the kernel's order).
+  const auto coordinate = [&](int k, float lower, float upper, float& x) {
+    const float o = ray.origin[k], step = t * ray.dir[k];
+    x = o + step;
+    const float slack = kMargin * (std::abs(o) + std::abs(step));
+    return x + slack >= lower && x - slack <= upper;
+  };
+  float a, b;
+  const bool insideA = coordinate(across[0], lo[0], hi[0], a);
+  const bool insideB = coordinate(across[1], lo[1], hi[1], b);
+  if (!(insideA && insideB)) return false;
+  out = {t, a, b};
   return true;
 }
 
-uint32_t axisRectangleCrossings(const RayLanes& rays, const ExactAxisRectangle& rect, uint32_t lanes,
-                                RectangleLanes& out) {
-  return HWY_DYNAMIC_DISPATCH(AxisRectangleCrossingsKernel)(rays, rect, lanes, out);
+uint32_t axisRectangleCrossings(const RayLanes& rays, const AxisRectangle& rect, uint32_t lanes) {
+  return HWY_DYNAMIC_DISPATCH(AxisRectangleCrossingsKernel)(rays, rect, lanes);
 }
 
-uint32_t axisRectangleHits(const RayLanes& rays, const ExactAxisRectangle& rect, RectangleLanes& out,
-                           float* t, const Vec2* uvCorners, float* u, float* v) {
-  return HWY_DYNAMIC_DISPATCH(AxisRectangleHitsKernel)(rays, rect, out, t, uvCorners, u, v);
+uint32_t axisRectangleHits(const RayLanes& rays, const AxisRectangle& rect, float* t, const Vec2* uvCorners,
+                           float* u, float* v) {
+  return HWY_DYNAMIC_DISPATCH(AxisRectangleHitsKernel)(rays, rect, t, uvCorners, u, v);
 }
 
 uint32_t discCrossings(const RayLanes& rays, const ExactDisc& disc, const float* tMax, uint32_t lanes,

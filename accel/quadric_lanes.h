@@ -1,12 +1,14 @@
-// The exact intersection routines of the disc, the cylinder's and cone's lateral surfaces, the
-// box and the axis-aligned rectangle, each in two forms computed by the same double-precision operations in
-// the same order: a scalar one for a single ray (Shape::intersect) and a Highway kernel for a block of packet
-// lanes at once (Shape::intersectLanes, the route of every ray Embree traces). IEEE arithmetic rounds the
-// same in a vector lane as in a scalar register, and this file's implementation is compiled without fused
-// multiply-adds, so each lane's result equals the scalar routine's bit for bit (tests/test_shape_lanes.cpp).
-// The shapes build their LocalHit from these results with one shared scalar function, so the hits the two
-// routes report are identical too. Unlike the sphere's and the other flat shapes' kernels, no float filter
-// runs first: a ray reaching one of these shapes' bounding boxes usually hits it.
+// The intersection routines of the disc, the cylinder's and cone's lateral surfaces, the box and the
+// axis-aligned rectangle, each in two forms computed by the same operations in the same order: a scalar
+// one for a single ray (Shape::intersect) and a Highway kernel for a block of packet lanes at once
+// (Shape::intersectLanes, the route of every ray Embree traces). The quadrics and the box are exact
+// tests in double precision; the rectangle, the commonest flat shape, is a float test with a
+// conservative margin (AxisRectangle). IEEE arithmetic rounds the same in a vector lane as in a scalar
+// register, and this file's implementation is compiled without fused multiply-adds, so each lane's
+// result equals the scalar routine's bit for bit (tests/test_shape_lanes.cpp). The shapes build their
+// LocalHit from these results with one shared scalar function, so the hits the two routes report are
+// identical too. Unlike the sphere's and the other flat shapes' kernels, no float filter runs first: a
+// ray reaching one of these shapes' bounding boxes usually hits it.
 #pragma once
 
 #include "accel/shape_lanes.h"
@@ -84,41 +86,46 @@ uint32_t boxCrossings(const RayLanes& rays, const ExactBox& box, uint32_t lanes,
 
 // An axis-aligned rectangle, the commonest flat shape (walls, floors, area lights): the plane
 // x[axis] = c crossed within (tMin, tMax) at a point whose other two coordinates (along across[0]
-// and across[1]) lie in [lo, hi], bounds included. The plane's denominator is the direction's own
-// component and c - o[axis] is exact in double (unless the two floats' exponents lie more than 29
-// apart), so t is a single rounding of the exact quotient;
-// the crossing's coordinates are compared with the rectangle's bounds directly.
+// and across[1]) lie in [lo, hi], bounds included. In float, 16 lanes per AVX-512 vector: the
+// plane's denominator is the direction's own component, so t = (c - o[axis]) / dir[axis] is two
+// roundings from the exact quotient (one where c and o[axis] are within a factor of two, as for a
+// ray leaving the plane, whose t is then exactly signed). The crossing's coordinates a = o + t dir
+// carry at most 4 ulps of |o| + |t dir| of error (t's two roundings, the product's and the sum's),
+// so the bounds are widened by kMargin times that much, lane by lane: a ray that crosses the
+// exact rectangle is never missed, so two rectangles that share an edge leave no crack between
+// them; a hit at most a few ulps outside an edge is kept.
 struct RectangleCrossing {
-  double t, a, b;  // the coordinates along across[0] and across[1]
+  float t, a, b;  // the coordinates along across[0] and across[1]
 };
-struct ExactAxisRectangle {
+struct AxisRectangle {
+  // 8 ulps (2^-24 each) of |o| + |t dir|: twice the error bound, for the rounding of the bound
+  // and of the comparison's own sum.
+  static constexpr float kMargin = 8.0f * 0x1p-24f;
   int axis = 2;
   int across[2] = {0, 1};
-  double c = 0.0;
-  double lo[2] = {0.0, 0.0}, hi[2] = {0.0, 0.0};
-  double corner[2] = {0.0, 0.0};  // v0 along across[0], across[1]
-  double edge[2] = {1.0, 1.0};    // v1 - v0 along across[0] and v3 - v0 along across[1], signed
+  float c = 0.0f;
+  float lo[2] = {0.0f, 0.0f}, hi[2] = {0.0f, 0.0f};
+  float corner[2] = {0.0f, 0.0f};  // v0 along across[0], across[1]
+  float edge[2] = {1.0f, 1.0f};    // v1 - v0 along across[0] and v3 - v0 along across[1], signed
 
   // The rectangle of the quad with corners v0, v1, v2, v3, if it is one: the corners share one
   // coordinate bit for bit, the edges v1 - v0 and v3 - v0 each run along one of the other two axes
   // (non-zero and finite), and v2 = v1 + v3 - v0 exactly.
-  static bool of(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Vec3& v3, ExactAxisRectangle& out);
+  static bool of(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Vec3& v3, AxisRectangle& out);
   bool cross(const Ray& ray, float tMin, float tMax, RectangleCrossing& out) const;
+  // The quad's texture coordinates' parameters at a crossing: the crossing along v1 - v0 and
+  // v3 - v0 in units of the edges.
+  Vec2 edgeCoordinates(float a, float b) const {
+    return {(a - corner[0]) / edge[0], (b - corner[1]) / edge[1]};
+  }
 };
-struct RectangleLanes {
-  alignas(64) double t[RayLanes::kMaxLanes];
-  alignas(64) double a[RayLanes::kMaxLanes];
-  alignas(64) double b[RayLanes::kMaxLanes];
-};
-uint32_t axisRectangleCrossings(const RayLanes& rays, const ExactAxisRectangle& rect, uint32_t lanes,
-                                RectangleLanes& out);
-// axisRectangleCrossings of the rays' live lanes (valid), also writing each lane's t rounded to
-// float into t[0, rays.n): a quad's hits in one call, without a pass for the live lanes first nor
-// one converting the hits' t lane by lane.
-// With `uvCorners` (the quad's UV at v0..v3) also each lane's texture coordinates into u and v,
-// exactly as Quad::rectangleUv computes them from the crossing: the plane coordinates in double,
-// rounded to float, then the UV of the half (v0, v1, v2) or (v0, v2, v3) they fall in.
-uint32_t axisRectangleHits(const RayLanes& rays, const ExactAxisRectangle& rect, RectangleLanes& out,
-                           float* t, const Vec2* uvCorners = nullptr, float* u = nullptr, float* v = nullptr);
+// The rectangle's test for the lanes of `rays` named by `lanes`: the mask of those that cross it.
+uint32_t axisRectangleCrossings(const RayLanes& rays, const AxisRectangle& rect, uint32_t lanes);
+// The test for the rays' live lanes (valid), writing each lane's t into t[0, rays.n): a quad's
+// hits in one call. With `uvCorners` (the quad's UV at v0..v3) also each lane's texture
+// coordinates into u and v, exactly as Quad::rectangleUv computes them from the crossing: its
+// edgeCoordinates, then the UV of the half (v0, v1, v2) or (v0, v2, v3) they fall in.
+uint32_t axisRectangleHits(const RayLanes& rays, const AxisRectangle& rect, float* t,
+                           const Vec2* uvCorners = nullptr, float* u = nullptr, float* v = nullptr);
 
 }  // namespace ember

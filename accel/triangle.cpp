@@ -161,7 +161,7 @@ Quad::Quad(const std::array<Vec3, 4>& v, const std::array<Vec2, 4>& uv)
   sampling_ = QuadSampling::of(corners, rectangle_, normal_, area0_, area1_);
   if (singleFilter_) {
     filters_[0] = filters_[1] = TriangleFilter::of(v[0], v[1], v[3], planes_[0], true);
-    axisAligned_ = ExactAxisRectangle::of(v[0], v[1], v[2], v[3], exactRectangle_);
+    axisAligned_ = AxisRectangle::of(v[0], v[1], v[2], v[3], axisRectangle_);
     coords_[0] = coords_[1] = PlaneCoordinates::of(v[0], v[1], v[3]);
   } else {
     filters_[0] = TriangleFilter::of(v[0], v[1], v[2], planes_[0]);
@@ -195,8 +195,8 @@ bool Quad::intersectHalf(int half, const Ray& ray, float tMin, float tMax, Local
 bool Quad::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) const {
   if (axisAligned_) {
     RectangleCrossing crossing;
-    if (!exactRectangle_.cross(ray, tMin, tMax, crossing)) return false;
-    hit = LocalHit{float(crossing.t), normal_, rectangleUv(crossing.a, crossing.b)};
+    if (!axisRectangle_.cross(ray, tMin, tMax, crossing)) return false;
+    hit = LocalHit{crossing.t, normal_, rectangleUv(crossing.a, crossing.b)};
     return true;
   }
   if (!intersectHalf(0, ray, tMin, tMax, hit)) return intersectHalf(1, ray, tMin, tMax, hit);
@@ -219,11 +219,10 @@ bool Quad::settledHit(int half, const Ray& ray, float tMin, float tMax, bool nee
 }
 
 // The UV of an axis-aligned rectangle's crossing at coordinates (a, b), for intersect();
-// intersectLanes() has the rectangle kernel compute the same (rectangleUvLanes in
+// intersectLanes() has the rectangle kernel compute the same (axisRectangleLanes in
 // accel/quadric_lanes.cpp), held to this bit for bit by tests/test_shape_lanes.cpp.
-Vec2 Quad::rectangleUv(double a, double b) const {
-  const ExactAxisRectangle& r = exactRectangle_;
-  return parallelogramUv(Vec2(float((a - r.corner[0]) / r.edge[0]), float((b - r.corner[1]) / r.edge[1])));
+Vec2 Quad::rectangleUv(float a, float b) const {
+  return parallelogramUv(axisRectangle_.edgeCoordinates(a, b));
 }
 
 Vec2 Quad::parallelogramUv(Vec2 b) const {
@@ -246,8 +245,7 @@ void Quad::halfLanes(int half, const RayLanes& rays, TriangleLanes& out) const {
 
 uint32_t Quad::candidateLanes(const RayLanes& rays) const {
   if (axisAligned_) {
-    RectangleLanes crossings;
-    return axisRectangleCrossings(rays, exactRectangle_, Shape::candidateLanes(rays), crossings);
+    return axisRectangleCrossings(rays, axisRectangle_, Shape::candidateLanes(rays));
   }
   TriangleLanes lanes;
   halfLanes(0, rays, lanes);
@@ -264,10 +262,8 @@ void Quad::intersectLanes(const RayLanes& rays, LaneHits& out) const {
     // Every live lane through the exact test at once: a ray that reaches an axis-aligned
     // rectangle's bounding box has crossed its plane within its bounds, so it nearly always hits.
     // Their texture coordinates too, in the kernel (rectangleUv for every lane at once).
-    RectangleLanes crossings;
-    out.mask = rays.needsUv ? axisRectangleHits(rays, exactRectangle_, crossings, out.t, uv_.data(),
-                                                out.uv[0], out.uv[1])
-                            : axisRectangleHits(rays, exactRectangle_, crossings, out.t);
+    out.mask = rays.needsUv ? axisRectangleHits(rays, axisRectangle_, out.t, uv_.data(), out.uv[0], out.uv[1])
+                            : axisRectangleHits(rays, axisRectangle_, out.t);
     if (out.mask != 0) out.fillFlat(normal_, !rays.needsUv);
     return;
   }
@@ -321,9 +317,9 @@ SurfacePoint Quad::projectToSurface(const Vec3& p, const LocalHit&) const {
     // Coordinate by coordinate: GCC kept a double vector indexed by k on the stack, and its wide
     // reload after the narrow store of coordinate k stalled on store-to-load forwarding (`perf
     // annotate`, an AVX-512 Xeon). The other coordinates round-trip through double unchanged.
-    const double c = exactRectangle_.c;
+    const double c = double(axisRectangle_.c);
     const auto onPlane = [c](float x) { return float(double(x) - (double(x) - c)); };
-    switch (exactRectangle_.axis) {
+    switch (axisRectangle_.axis) {
       case 0:
         return roundedPoint(onPlane(p.x), p.y, p.z);
       case 1:

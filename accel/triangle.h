@@ -79,7 +79,7 @@ class Quad final : public Shape {
   // The UV of the point with coordinates b in the single filter's parallelogram (v0, v1, v3).
   Vec2 parallelogramUv(Vec2 b) const;
   // The UV of an axis-aligned rectangle's crossing at coordinates (a, b).
-  Vec2 rectangleUv(double a, double b) const;
+  Vec2 rectangleUv(float a, float b) const;
 
   bool rectangle_;
   std::array<Vec3, 4> v_;
@@ -90,9 +90,9 @@ class Quad final : public Shape {
   TriangleFilter filters_[2];   // of the same halves, or twice the one of the whole parallelogram
   PlaneCoordinates coords_[2];  // likewise
   bool singleFilter_ = false;
-  // An axis-aligned rectangle is intersected exactly, in one double-precision kernel for a block.
+  // An axis-aligned rectangle has its own test (accel/quadric_lanes.h), one float kernel per block.
   bool axisAligned_ = false;
-  ExactAxisRectangle exactRectangle_;
+  AxisRectangle axisRectangle_;
   float area0_, area1_;    // of (v0,v1,v2) and (v0,v2,v3)
   QuadSampling sampling_;  // what the light-sampling kernel needs
 };

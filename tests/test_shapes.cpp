@@ -748,8 +748,8 @@ TEST(ShapeQuad, AxisAlignedProjectionEqualsTheGeneralPlane) {
         };
         std::array<Vec3, 4> v = {corner(-1, -2), corner(3, -2), corner(3, 4), corner(-1, 4)};
         if (flip) std::swap(v[1], v[3]);
-        ExactAxisRectangle rect;
-        ASSERT_TRUE(ExactAxisRectangle::of(v[0], v[1], v[2], v[3], rect));  // the specialised route
+        AxisRectangle rect;
+        ASSERT_TRUE(AxisRectangle::of(v[0], v[1], v[2], v[3], rect));  // the specialised route
         const Quad quad(v, {Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)});
         const DoublePlane plane = DoublePlane::through(v[0], v[1], v[2]);
         for (int i = 0; i < 200; ++i) {
