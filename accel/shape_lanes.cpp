@@ -206,7 +206,8 @@ uint32_t SphereHitsKernel(const RayLanes& rays, const Vec3& center, float radius
   const unsigned step = unsigned(hn::Lanes(d));
   const Vec3V64 c = splat64(d, double(center.x), double(center.y), double(center.z));
   const V64 r2 = hn::Set(d, double(radius) * double(radius));
-  const V64 two = hn::Set(d, 2.0), one = hn::Set(d, 1.0);
+  const V64 inv = hn::Set(d, 1.0 / double(radius));
+  const V64 two = hn::Set(d, 2.0);
   uint32_t hits = 0;
   for (unsigned i = 0; i < rays.n; i += step) {
     const M64 live = blockMask(d, candidates, i);
@@ -226,10 +227,9 @@ uint32_t SphereHitsKernel(const RayLanes& rays, const Vec3& center, float radius
     const V64 t = hn::IfThenElse(loOut, roots.t1, roots.t0);
     const M64 hit =
         hn::And(live, hn::And(roots.real, hn::Not(hn::And(loOut, outsideInterval(roots.t1, tMin, tMax)))));
-    // The unit normal: glm::normalize(oc + t d) = v * (1 / sqrt(dot(v, v))).
+    // The unit normal (Sphere::intersect): (oc + t d) / radius.
     const V64 lx = hn::Add(ox, hn::Mul(t, dx)), ly = hn::Add(oy, hn::Mul(t, dy)),
               lz = hn::Add(oz, hn::Mul(t, dz));
-    const V64 inv = hn::Div(one, hn::Sqrt(dot64(lx, ly, lz, lx, ly, lz)));
     hn::StoreU(hn::DemoteTo(df, t), df, out.t + i);
     hn::StoreU(hn::DemoteTo(df, hn::Mul(lx, inv)), df, out.ng[0] + i);
     hn::StoreU(hn::DemoteTo(df, hn::Mul(ly, inv)), df, out.ng[1] + i);

@@ -36,9 +36,13 @@ bool Sphere::intersect(const Ray& ray, float tMin, float tMax, LocalHit& hit) co
     t = t1;
     if (t <= tMin || t >= tMax) return false;
   }
+  // The unit normal as the point's offset from the centre over the radius: the point lies on the
+  // sphere to double precision (even at grazing incidence, where t's error moves it along the
+  // tangent), so its length rounds to 1 in float as a normalisation's does, without a square root
+  // and a division.
   const glm::dvec3 local = oc + t * d;
   hit.t = float(t);
-  hit.ng = Vec3(glm::normalize(local));
+  hit.ng = Vec3(local * (1.0 / double(radius_)));
   hit.uv = Vec2(0.0f);  // surfaceUv derives it from the normal
   return true;
 }
