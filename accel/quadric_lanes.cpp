@@ -200,12 +200,14 @@ HWY_INLINE uint32_t axisRectangleLanes(const RayLanes& rays, const AxisRectangle
       // Quad::rectangleUv: (s, r) = edgeCoordinates(a, b) along v1 - v0 and v3 - v0, the half
       // (v0, v1, v2) where s >= r, with barycentrics (s - r, r); the other (v0, v2, v3) with
       // (s, r - s). Then uvAt: (1 - b1 - b2) uv0 + b1 uvA + b2 uvB.
-      const VF s = hn::Div(hn::Sub(a, hn::Set(d, rect.corner[0])), hn::Set(d, rect.edge[0]));
-      const VF r = hn::Div(hn::Sub(b, hn::Set(d, rect.corner[1])), hn::Set(d, rect.edge[1]));
+      const VF one = hn::Set(d, 1.0f);
+      const auto unit = [&](VF x) { return hn::Min(hn::Max(x, zero), one); };  // std::min(std::max(x, 0), 1)
+      const VF s = unit(hn::Div(hn::Sub(a, hn::Set(d, rect.corner[0])), hn::Set(d, rect.edge[0])));
+      const VF r = unit(hn::Div(hn::Sub(b, hn::Set(d, rect.corner[1])), hn::Set(d, rect.edge[1])));
       const auto first = hn::Ge(s, r);
       const VF b1 = hn::IfThenElse(first, hn::Sub(s, r), s);
       const VF b2 = hn::IfThenElse(first, r, hn::Sub(r, s));
-      const VF w0 = hn::Sub(hn::Sub(hn::Set(d, 1.0f), b1), b2);
+      const VF w0 = hn::Sub(hn::Sub(one, b1), b2);
       float* const outs[2] = {u, v};
       for (int m = 0; m < 2; ++m) {
         const VF uvA = hn::IfThenElse(first, hn::Set(d, uvCorners[1][m]), hn::Set(d, uvCorners[2][m]));

@@ -14,6 +14,7 @@
 #include "accel/shape_lanes.h"
 #include "core/math.h"
 
+#include <algorithm>
 #include <cstdint>
 
 namespace ember {
@@ -93,13 +94,17 @@ uint32_t boxCrossings(const RayLanes& rays, const ExactBox& box, uint32_t lanes,
 // carry at most 4 ulps of |o| + |t dir| of error (t's two roundings, the product's and the sum's),
 // so the bounds are widened by kMargin times that much, lane by lane: a ray that crosses the
 // exact rectangle is never missed, so two rectangles that share an edge leave no crack between
-// them; a hit at most a few ulps outside an edge is kept.
+// them. The price: a ray that passes outside any edge (a light's rim too) by less than the margin,
+// a few ulps of |o| + |t dir|, counts as a hit; its texture coordinates are those of the nearest
+// point of the rectangle (edgeCoordinates clamps them). The bound is relative: it assumes no
+// underflow (scenes at 1e-30 scale) and no overflow (|o| + |t dir| near 1e38, where every lane
+// becomes a hit).
 struct RectangleCrossing {
   float t, a, b;  // the coordinates along across[0] and across[1]
 };
 struct AxisRectangle {
-  // 8 ulps (2^-24 each) of |o| + |t dir|: twice the error bound, for the rounding of the bound
-  // and of the comparison's own sum.
+  // 8 ulps (2^-24 each) of |o| + |t dir|: twice the error bound, as a safety factor (2^-21, so
+  // multiplying by it is exact; the comparisons themselves need none, as lo and hi are floats).
   static constexpr float kMargin = 8.0f * 0x1p-24f;
   int axis = 2;
   int across[2] = {0, 1};
@@ -114,11 +119,14 @@ struct AxisRectangle {
   static bool of(const Vec3& v0, const Vec3& v1, const Vec3& v2, const Vec3& v3, AxisRectangle& out);
   bool cross(const Ray& ray, float tMin, float tMax, RectangleCrossing& out) const;
   // The quad's texture coordinates' parameters at a crossing: the crossing along v1 - v0 and
-  // v3 - v0 in units of the edges.
+  // v3 - v0 in units of the edges, clamped to [0, 1] (a hit in the margin outside an edge takes
+  // the edge's coordinates, not those a repeating texture would wrap to the opposite edge).
   Vec2 edgeCoordinates(float a, float b) const {
-    return {(a - corner[0]) / edge[0], (b - corner[1]) / edge[1]};
+    const auto unit = [](float x) { return std::min(std::max(x, 0.0f), 1.0f); };
+    return {unit((a - corner[0]) / edge[0]), unit((b - corner[1]) / edge[1])};
   }
 };
+
 // The rectangle's test for the lanes of `rays` named by `lanes`: the mask of those that cross it.
 uint32_t axisRectangleCrossings(const RayLanes& rays, const AxisRectangle& rect, uint32_t lanes);
 // The test for the rays' live lanes (valid), writing each lane's t into t[0, rays.n): a quad's

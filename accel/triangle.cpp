@@ -259,7 +259,7 @@ uint32_t Quad::candidateLanes(const RayLanes& rays) const {
 // as in intersect(), the closer half wins when both are hit.
 void Quad::intersectLanes(const RayLanes& rays, LaneHits& out) const {
   if (axisAligned_) {
-    // Every live lane through the exact test at once: a ray that reaches an axis-aligned
+    // Every live lane through the rectangle's test at once: a ray that reaches an axis-aligned
     // rectangle's bounding box has crossed its plane within its bounds, so it nearly always hits.
     // Their texture coordinates too, in the kernel (rectangleUv for every lane at once).
     out.mask = rays.needsUv ? axisRectangleHits(rays, axisRectangle_, out.t, uv_.data(), out.uv[0], out.uv[1])

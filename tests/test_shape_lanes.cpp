@@ -473,7 +473,7 @@ TEST(ShapeLanes, KernelSettlesHitsAwayFromEdges) {
 // The axis-aligned rectangle's kernel against its scalar routine on the inputs where a lane mask
 // could diverge from a branch: a zero direction component of either sign, NaN and infinite
 // components, empty and reversed intervals, origins on the plane and exactly on an edge's line.
-TEST(ShapeLanes, AxisRectangleKernelEqualsTheScalarOnSpecialRays) {
+void expectAxisRectangleKernelEqualsTheScalar() {
   const Vec3 v0(-1.0f, 0.5f, -0.5f), v1(1.0f, 0.5f, -0.5f), v2(1.0f, 0.5f, 0.5f), v3(-1.0f, 0.5f, 0.5f);
   AxisRectangle rect;
   ASSERT_TRUE(AxisRectangle::of(v0, v1, v2, v3, rect));
@@ -535,10 +535,16 @@ TEST(ShapeLanes, AxisRectangleKernelEqualsTheScalarOnSpecialRays) {
   }
 }
 
+TEST(ShapeLanes, AxisRectangleKernelEqualsTheScalarOnSpecialRaysOnEveryTarget) {
+  forEachSimdTarget(expectAxisRectangleKernelEqualsTheScalar);
+}
+
 // Two rectangles that share an edge (a floor and a wall) leave no crack: a ray aimed at a point
 // of the edge, from anywhere inside the corner they make, at any scale and offset, crosses at
-// least one of them, in the scalar routine and in the kernel alike. Without the margin
-// (AxisRectangle::kMargin set to 0) float rounding lets rays through, and this test fails.
+// least one of them, in the scalar routine and in the kernel alike, with texture coordinates
+// within the corners'. Without the margin (AxisRectangle::kMargin set to 0) float rounding lets
+// rays through, and this test fails; without edgeCoordinates' clamp, a hit in the margin gets
+// texture coordinates past an edge.
 TEST(ShapeLanes, AbuttingAxisRectanglesLeaveNoCrack) {
   forEachSimdTarget([] {
     Rng rng(41, 2);
@@ -563,9 +569,20 @@ TEST(ShapeLanes, AbuttingAxisRectanglesLeaveNoCrack) {
             ray[i] = Ray{origin, glm::normalize(target - origin)};
             block.set(i, ray[i], true);
           }
-          float t[RayLanes::kMaxLanes];
-          const uint32_t lanes =
-              axisRectangleHits(block.lanes(), floor, t) | axisRectangleHits(block.lanes(), wall, t);
+          // Texture coordinates too: a hit in the margin outside an edge takes the edge's, never
+          // ones past the corners' (which a repeating texture would wrap to the opposite edge).
+          const Vec2 uv[4] = {Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)};
+          float t[RayLanes::kMaxLanes], u[RayLanes::kMaxLanes], v[RayLanes::kMaxLanes];
+          uint32_t lanes = 0;
+          for (const AxisRectangle* rect : {&floor, &wall}) {
+            const uint32_t hits = axisRectangleHits(block.lanes(), *rect, t, uv, u, v);
+            for (uint32_t bits = hits; bits != 0; bits &= bits - 1) {
+              const unsigned i = unsigned(__builtin_ctz(bits));
+              ASSERT_TRUE(u[i] >= 0.0f && u[i] <= 1.0f && v[i] >= 0.0f && v[i] <= 1.0f)
+                  << "uv " << u[i] << " " << v[i] << ": " << describe(ray[i]);
+            }
+            lanes |= hits;
+          }
           for (unsigned i = 0; i < RayLanes::kMaxLanes; ++i) {
             RectangleCrossing crossing;
             const bool scalar = floor.cross(ray[i], 0.0f, kInfinity, crossing) ||
