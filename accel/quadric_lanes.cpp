@@ -7,6 +7,7 @@
 #include <hwy/highway.h>
 
 #include "accel/double_lanes-inl.h"
+#include "accel/float_lanes-inl.h"
 #include "accel/quadric_lanes.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -162,7 +163,6 @@ HWY_INLINE uint32_t axisRectangleLanes(const RayLanes& rays, const AxisRectangle
                                        float* tOut, const Vec2* uvCorners = nullptr, float* u = nullptr,
                                        float* v = nullptr) {
   const hn::CappedTag<float, RayLanes::kMaxLanes> d;
-  const hn::RebindToSigned<decltype(d)> di;
   using VF = hn::Vec<decltype(d)>;
   const unsigned step = unsigned(hn::Lanes(d));
   const unsigned k = unsigned(rect.axis), ia = unsigned(rect.across[0]), ib = unsigned(rect.across[1]);
@@ -171,13 +171,8 @@ HWY_INLINE uint32_t axisRectangleLanes(const RayLanes& rays, const AxisRectangle
   const VF loB = hn::Set(d, rect.lo[1]), hiB = hn::Set(d, rect.hi[1]);
   uint32_t hits = 0;
   for (unsigned i = 0; i < rays.n; i += step) {
-    auto live = hn::FirstN(d, rays.n - i);
-    if constexpr (kLiveFromValid) {
-      live = hn::And(live, hn::RebindMask(d, hn::Eq(hn::LoadU(di, rays.valid + i), hn::Set(di, -1))));
-    } else {
-      uint8_t bits[8] = {uint8_t(lanes >> i), uint8_t(lanes >> (i + 8))};
-      live = hn::And(live, hn::LoadMaskBits(d, bits));
-    }
+    const auto live =
+        hn::And(hn::FirstN(d, rays.n - i), kLiveFromValid ? validLanes(d, rays, i) : namedLanes(d, lanes, i));
     if (hn::AllFalse(d, live)) continue;
     const VF denom = hn::LoadU(d, rays.dir[k] + i);
     const VF t = hn::Div(hn::Sub(c, hn::LoadU(d, rays.org[k] + i)), denom);
@@ -217,9 +212,7 @@ HWY_INLINE uint32_t axisRectangleLanes(const RayLanes& rays, const AxisRectangle
         hn::StoreU(sum, d, outs[m] + i);
       }
     }
-    uint8_t bits[8] = {};
-    hn::StoreMaskBits(d, hit, bits);
-    hits |= (uint32_t(bits[0]) | uint32_t(bits[1]) << 8) << i;
+    hits |= maskBits(d, hit) << i;
   }
   return hits;
 }

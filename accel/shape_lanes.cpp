@@ -5,6 +5,7 @@
 #include <hwy/highway.h>
 
 #include "accel/double_lanes-inl.h"
+#include "accel/float_lanes-inl.h"
 #include "accel/shape.h"
 #include "accel/shape_lanes.h"
 
@@ -48,22 +49,13 @@ struct LaneBlock {
 };
 
 HWY_INLINE LaneBlock loadBlock(D d, const RayLanes& r, unsigned i) {
-  const hn::RebindToSigned<D> di;
   LaneBlock b;
   b.o = {hn::LoadU(d, r.org[0] + i), hn::LoadU(d, r.org[1] + i), hn::LoadU(d, r.org[2] + i)};
   b.dir = {hn::LoadU(d, r.dir[0] + i), hn::LoadU(d, r.dir[1] + i), hn::LoadU(d, r.dir[2] + i)};
   b.tMin = hn::LoadU(d, r.tnear + i);
   b.tMax = hn::LoadU(d, r.tfar + i);
-  b.live = hn::RebindMask(d, hn::Eq(hn::LoadU(di, r.valid + i), hn::Set(di, -1)));
+  b.live = validLanes(d, r, i);
   return b;
-}
-
-HWY_INLINE uint32_t maskBits(D d, M m) {
-  uint8_t bytes[8] = {};
-  hn::StoreMaskBits(d, m, bytes);
-  uint32_t bits = 0;
-  for (size_t k = 0; k < (hn::Lanes(d) + 7) / 8; ++k) bits |= uint32_t(bytes[k]) << (8 * k);
-  return bits;
 }
 
 // The rays are read in blocks of Lanes(d), which D caps at kMaxLanes and which divides it: a block
@@ -87,11 +79,9 @@ unsigned RayLanesStep() {
 
 uint32_t LiveLanes(const RayLanes& rays) {
   const D d;
-  const hn::RebindToSigned<D> di;
   const unsigned step = unsigned(hn::Lanes(d));
   uint32_t bits = 0;
-  for (unsigned i = 0; i < rays.n; i += step)
-    bits |= maskBits(d, hn::RebindMask(d, hn::Eq(hn::LoadU(di, rays.valid + i), hn::Set(di, -1)))) << i;
+  for (unsigned i = 0; i < rays.n; i += step) bits |= maskBits(d, validLanes(d, rays, i)) << i;
   const uint32_t inRange = rays.n >= 32 ? ~0u : (1u << rays.n) - 1u;
   return bits & inRange;
 }
