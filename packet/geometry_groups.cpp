@@ -8,11 +8,17 @@ namespace ember {
 void GeometryGroups::group(const ClosestHitBatch& batch, size_t active, size_t geometries) {
   if (active > kMaxLanes) throw std::logic_error("GeometryGroups: more lanes than it holds");
   const size_t buckets = geometries + 1;
+  runCount_ = 0;
   if (buckets > kMaxCountingSortBuckets) {
     for (size_t a = 0; a < active; ++a)
       sortKey_[a] = uint64_t(batch.geometryOf(a) + 1u) << 16 | a;  // misses (0) first
     std::sort(sortKey_.begin(), sortKey_.begin() + ptrdiff_t(active));
-    for (size_t o = 0; o < active; ++o) order_[o] = uint16_t(sortKey_[o] & 0xffffu);
+    for (size_t o = 0; o < active; ++o) {
+      order_[o] = uint16_t(sortKey_[o] & 0xffffu);
+      if (o == 0 || (sortKey_[o] >> 16) != (sortKey_[o - 1] >> 16))
+        runs_[runCount_++] = Run{uint32_t(sortKey_[o] >> 16) - 1u, uint16_t(o), uint16_t(o)};
+      ++runs_[runCount_ - 1].end;
+    }
     return;
   }
   // kWays counting sorts' counters, one per consecutive range of the batch, visited in turn: most
@@ -31,12 +37,15 @@ void GeometryGroups::group(const ClosestHitBatch& batch, size_t active, size_t g
       ++start_[w * buckets + key];
     }
   uint16_t next = 0;
-  for (size_t b = 0; b < buckets; ++b)
+  for (size_t b = 0; b < buckets; ++b) {
+    const uint16_t begin = next;
     for (size_t w = 0; w < kWays; ++w) {
       const uint16_t count = start_[w * buckets + b];
       start_[w * buckets + b] = next;
       next = uint16_t(next + count);
     }
+    if (next != begin) runs_[runCount_++] = Run{uint32_t(b) - 1u, begin, next};  // bucket 0: ~0u
+  }
   for (size_t i = 0; i < range; ++i)
     for (size_t w = 0; w < kWays; ++w) {
       const size_t a = w * range + i;

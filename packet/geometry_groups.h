@@ -20,16 +20,28 @@ class GeometryGroups {
   // keys to sort.
   static constexpr size_t kMaxCountingSortBuckets = 1024;
 
-  // order()[0, active) lists the batch indices [0, active) of `batch`, grouped by geomID.
+  // A group: order()[begin, end) are the batch indices whose rays hit `geometry`
+  // (RTC_INVALID_GEOMETRY_ID: the misses).
+  struct Run {
+    uint32_t geometry;
+    uint16_t begin, end;
+  };
+
+  // order()[0, active) lists the batch indices [0, active) of `batch`, grouped by geomID, and
+  // runs()[0, runCount()) the groups in that order, none empty.
   void group(const ClosestHitBatch& batch, size_t active, size_t geometries);
   const uint16_t* order() const { return order_.data(); }
+  const Run* runs() const { return runs_.data(); }
+  size_t runCount() const { return runCount_; }
 
  private:
   std::array<uint16_t, kMaxLanes> order_;
   std::array<uint32_t, kMaxLanes> key_;      // geomID + 1 of each batch index's hit, 0 for a miss
   std::array<uint64_t, kMaxLanes> sortKey_;  // (geomID + 1) << 16 | batch index, for many geometries
-  static constexpr size_t kWays = 4;         // counters per bucket (geometry_groups.cpp)
-  std::vector<uint16_t> start_;  // counting-sort buckets, kWays per geometry, sized once per scene
+  std::array<Run, kMaxLanes> runs_;
+  size_t runCount_ = 0;
+  static constexpr size_t kWays = 4;  // counters per bucket (geometry_groups.cpp)
+  std::vector<uint16_t> start_;       // counting-sort buckets, kWays per geometry, sized once per scene
 };
 
 }  // namespace ember

@@ -4,6 +4,7 @@
 #include "core/warp_lanes.h"
 #include "materials/lambertian.h"
 #include "materials/specular.h"
+#include "packet/arrival_lanes.h"
 #include "packet/continuation_lanes.h"
 #include "packet/next_event_lanes.h"
 #include "packet/thread_wave.h"
@@ -59,6 +60,7 @@ struct LaneWave {
   CosineLanes cosine;
   Row<uint16_t> shadowVertex;
   Row<uint16_t> rouletteVertex;  // the vertices deep enough for Russian roulette
+  Row<int32_t> project;          // the vertices whose points the arrival kernel leaves to project
   // The bounce's hits in order of geometry: the vertices then run one shape's code at a time, and
   // their shadow rays and next rays, made in that order, fill packets with coherent rays (which
   // Embree traces 1.1-1.7x faster than rays in pixel order, measured on shapes.json).
@@ -72,6 +74,14 @@ void store3(float (&rows)[3][NextEventArrays::kStride], size_t v, const Vec3& va
 }
 Vec3 load3(const float (&rows)[3][NextEventArrays::kStride], size_t v) {
   return {rows[0][v], rows[1][v], rows[2][v]};
+}
+
+// The constant reflectance of a shape whose hits the arrival kernel takes: a Lambertian material
+// without a texture. Null for any other (a Dirac material, a textured one, none).
+const Color* constantLambertian(const Scene::GeometryRecord& rec) {
+  if (rec.deltaLobes || !rec.material || !rec.shape) return nullptr;
+  const auto* lambertian = dynamic_cast<const Lambertian*>(rec.material);
+  return lambertian ? lambertian->constantReflectance() : nullptr;
 }
 
 // A row triple as the pointers ClosestHitBatch::assign takes.
@@ -234,11 +244,28 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
       phases.mark(PathPhase::TraceClosest);
 
       // PathIntegrator::arrive for every path: its emission, or the environment's where it left
-      // the scene, and the vertices that scatter.
+      // the scene, and the vertices that scatter. A run of hits on a shape with a constant
+      // Lambertian reflectance arrives in the vector kernel (packet/arrival_lanes.h), every other
+      // hit one at a time.
       wave.groups.group(wave.closest, active, scene.geometryCount());
       size_t vertices = 0, lightDraws = 0;
-      for (size_t o = 0; o < active; ++o) {
-        const size_t s = wave.groups.order()[o];
+      // PathIntegrator::arrive's emission at vertex point p, normal ng, for the path in slot s; a
+      // caustic path's is the light tracer's.
+      const auto addEmission = [&](const Scene::GeometryRecord& rec, size_t s, const Vec3& p, const Vec3& ng,
+                                   const Vec3& wo, const Color& throughput) {
+        const bool previousDelta = paths.previousDelta[s] != 0;
+        const bool caustic = tracesCaustics && previousDelta && paths.firstBounceNonDelta[s] != 0 &&
+                             rec.light && rec.light->causticTraced;
+        if (isBlack(rec.emission) || !(rec.twoSidedEmission || glm::dot(wo, ng) > 0.0f) || caustic) return;
+        float weight = 1.0f;
+        if (!previousDelta) {
+          const float lightPdf =
+              rec.light ? lights.pmf(rec.light) * rec.light->pdf(load3(paths.previousPoint, s), p, ng) : 0.0f;
+          weight = powerHeuristic(paths.previousPdf[s], lightPdf);
+        }
+        wave.radiance[size_t(paths.owner[s])] += throughput * rec.emission * weight;
+      };
+      const auto arriveOne = [&](size_t s) {
         const Vec3 dir = load3(paths.dir, s);
         Color throughput = load3(paths.throughput, s);
         const int32_t owner = paths.owner[s];
@@ -252,7 +279,7 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
               weight = powerHeuristic(paths.previousPdf[s], lights.pmf(env) * env->pdfDirection(dir));
             wave.radiance[owner] += throughput * env->radiance(dir) * weight;
           }
-          continue;
+          return;
         }
         ++stats.vertices;
         const Scene::GeometryRecord& rec = scene.record(raw.geomID);
@@ -271,7 +298,7 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
           pError = hit->pError;
           if (glm::dot(dir, raw.ng) > 0.0f) {
             throughput *= material->interiorTransmittance(raw.t);
-            if (isBlack(throughput)) continue;
+            if (isBlack(throughput)) return;
           }
         } else {
           // Scene::surfaceHit for an analytic shape, without the parts a Lambertian vertex never
@@ -288,23 +315,11 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
             pError = roundingErrorBound(magnitude + raw.t);
           }
         }
-        // PathIntegrator::arrive's emission; a caustic path's is the light tracer's.
-        const bool caustic = tracesCaustics && previousDelta && paths.firstBounceNonDelta[s] != 0 &&
-                             rec.light && rec.light->causticTraced;
-        if (!isBlack(rec.emission) && (rec.twoSidedEmission || glm::dot(wo, raw.ng) > 0.0f) && !caustic) {
-          float weight = 1.0f;
-          if (!previousDelta) {
-            const float lightPdf =
-                rec.light ? lights.pmf(rec.light) * rec.light->pdf(load3(paths.previousPoint, s), p, raw.ng)
-                          : 0.0f;
-            weight = powerHeuristic(paths.previousPdf[s], lightPdf);
-          }
-          wave.radiance[owner] += throughput * rec.emission * weight;
-        }
-        if ((maxDepth >= 0 && paths.depth[s] >= maxDepth) || !material) continue;
+        addEmission(rec, s, p, raw.ng, wo, throughput);
+        if ((maxDepth >= 0 && paths.depth[s] >= maxDepth) || !material) return;
         const size_t v = vertices;
         if (isDirac) {
-          if (material->absorbsAt(*hit)) continue;
+          if (material->absorbsAt(*hit)) return;
           wave.dirac[v] = material;
         } else {
           const auto* lambertian = static_cast<const Lambertian*>(material);
@@ -312,7 +327,7 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
           const Color albedo =
               constant ? *constant
                        : lambertian->reflectanceAt(rec.shape->surfaceUv(LocalHit{raw.t, raw.ng, raw.uv}));
-          if (isBlack(albedo)) continue;  // Material::absorbsAt: black only where the texture may be
+          if (isBlack(albedo)) return;  // Material::absorbsAt: black only where the texture may be
           store3(nee.albedo, v, albedo);
           wave.dirac[v] = nullptr;
           if (!lights.empty()) wave.lightVertex[lightDraws++] = uint16_t(v);
@@ -335,6 +350,48 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
         cont.firstBounceNonDelta[v] = paths.firstBounceNonDelta[s];
         cont.maskFront[v] = rec.maskFront;
         cont.maskBack[v] = rec.maskBack;
+      };
+      const HitFields hitFields = wave.closest.hitFields();
+      for (size_t r = 0; r < wave.groups.runCount(); ++r) {
+        const GeometryGroups::Run run = wave.groups.runs()[r];
+        const uint16_t* slots = wave.groups.order() + run.begin;
+        const size_t count = size_t(run.end - run.begin);
+        const Color* albedo = run.geometry == RTC_INVALID_GEOMETRY_ID
+                                  ? nullptr
+                                  : constantLambertian(scene.record(run.geometry));
+        if (maxDepth >= 0 || !albedo || isBlack(*albedo)) {
+          for (size_t j = 0; j < count; ++j) arriveOne(slots[j]);
+          continue;
+        }
+        // Every path of the run scatters at its vertex: the depth is unbounded and the
+        // reflectance not black.
+        const Scene::GeometryRecord& rec = scene.record(run.geometry);
+        const size_t first = vertices;
+        const size_t far = arriveLambertianLanes(
+            hitFields, paths, LambertianRun{slots, count, first, *albedo, rec.maskFront, rec.maskBack}, nee,
+            cont, wave.project.data());
+        for (size_t j = 0; j < far; ++j) {  // the scalar arrival's projection branch
+          const size_t v = size_t(wave.project[j]);
+          RawHit raw;
+          wave.closest.hit(slots[v - first], raw);
+          const SurfacePoint onSurface =
+              rec.shape->projectToSurface(load3(nee.p, v), LocalHit{raw.t, raw.ng, raw.uv});
+          store3(nee.p, v, onSurface.p);
+          nee.pError[v] = onSurface.error;
+        }
+        if (!isBlack(rec.emission))
+          for (size_t j = 0; j < count; ++j) {
+            const size_t v = first + j;
+            addEmission(rec, slots[j], load3(nee.p, v), load3(nee.ng, v), load3(nee.wo, v),
+                        load3(nee.throughput, v));
+          }
+        std::fill_n(&wave.dirac[first], count, nullptr);
+        std::fill_n(&wave.bsdfUse[first], count,
+                    RequestUse{rec.material->usesDirectionSample(), rec.material->usesLobeSample()});
+        if (!lights.empty())
+          for (size_t j = 0; j < count; ++j) wave.lightVertex[lightDraws++] = uint16_t(first + j);
+        vertices += count;
+        stats.vertices += count;
       }
       phases.mark(PathPhase::Arrival);
 

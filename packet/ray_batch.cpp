@@ -195,6 +195,22 @@ bool ClosestHitBatch::hit(size_t i, RawHit& out) const {
   return true;
 }
 
+HitFields ClosestHitBatch::hitFields() const {
+  const unsigned n = storage_.width();
+  RTCRayHitN* p = packetOf(0);
+  RTCHitN* h = RTCRayHitN_HitN(p, n);
+  const float* base = storage_.packet(0);
+  const auto offset = [base](const float& field) { return uint32_t(&field - base); };
+  return HitFields{base,
+                   uint32_t(std::countr_zero(n)),
+                   n - 1,
+                   uint32_t(kFloatsPerRayHit * n),
+                   offset(RTCRayN_tfar(RTCRayHitN_RayN(p, n), n, 0)),
+                   offset(RTCHitN_Ng_x(h, n, 0)),
+                   offset(RTCHitN_Ng_y(h, n, 0)),
+                   offset(RTCHitN_Ng_z(h, n, 0))};
+}
+
 ShadowBatch::ShadowBatch(size_t capacity, unsigned width) : storage_(capacity, kFloatsPerRay, width) {}
 
 void ShadowBatch::push(const Ray& ray, uint32_t mask) {

@@ -55,6 +55,15 @@ class PacketStorage {
 
 }  // namespace detail
 
+// Where a ClosestHitBatch keeps its rays' hits, for kernels that gather them by index: field f of
+// ray i lies at base[(i >> shift) * stride + f + (i & laneMask)], f being one of the offsets below
+// (lane 0's field, in floats from the start of its packet).
+struct HitFields {
+  const float* base;
+  uint32_t shift, laneMask, stride;
+  uint32_t tfar, ngX, ngY, ngZ;
+};
+
 class ClosestHitBatch {
  public:
   static constexpr unsigned kDefaultWidth = 16;
@@ -80,6 +89,8 @@ class ClosestHitBatch {
   void trace(const EmbreeAccel& accel, BatchTraversal traversal = BatchTraversal::Packets);
   // The closest hit of ray i, as EmbreeAccel::intersect reports it; false if it hit nothing.
   bool hit(size_t i, RawHit& out) const;
+  // The layout hit() reads, valid until the next setWidth.
+  HitFields hitFields() const;
   // The geomID ray i hit, RTC_INVALID_GEOMETRY_ID for a miss.
   uint32_t geometryOf(size_t i) const {
     return RTCHitN_geomID(hitsOf(i), storage_.width(), storage_.laneOf(i));

@@ -21,6 +21,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -208,9 +209,9 @@ TEST(LaneKernel, DecidesAfreshForASceneBuiltAgain) {
 // analytic shape, a textured material, mirrors and glass (caustics path-traced or left to the
 // light tracer), emitters of every shape, one- and two-sided, facing in and out (a
 // sphere whose normals point inwards encloses the scene), point and spot lights, a black (absorbing)
-// material, paths cut by max depth and by Russian roulette from the second segment, both samplers, and waves
-// of one sample per pixel. The scene is then changed just outside the set, where the kernel must hand it to
-// the wavefront kernel. The camera is inside the inward-facing sphere.
+// material, paths cut by max depth or by Russian roulette alone from the second segment, both samplers, and
+// waves of one sample per pixel. The scene is then changed just outside the set, where the kernel must hand
+// it to the wavefront kernel. The camera is inside the inward-facing sphere.
 TEST(LaneKernel, SameImageAsScalarOnTheScenesItCovers) {
   const std::string path = (std::filesystem::temp_directory_path() / "ember_lanes_covered.json").string();
   const std::string checker = test::sourcePath("scenes/checker.png");
@@ -258,6 +259,17 @@ TEST(LaneKernel, SameImageAsScalarOnTheScenesItCovers) {
       expectKernelsAgree(scene, name);
       expectKernelsAgree(scene, name + ", one sample per pass", RenderCase{2, 16, 1, 3});
     }
+  // Unbounded depth (Russian roulette alone ends the paths): the runs of hits on constant
+  // Lambertian shapes then arrive in the vector kernel (packet/arrival_lanes.h), on every target.
+  scene.settings.maxDepth = -1;
+  for (bool caustics : {true, false}) {
+    scene.settings.traceCaustics = caustics;
+    forEachSimdTarget([&] {
+      expectKernelsAgree(
+          scene, caustics ? "unbounded depth, caustics traced" : "unbounded depth, caustics path-traced");
+    });
+  }
+  scene.settings.maxDepth = 7;
   // Open to the sky: without the enclosing sphere, under a sun (directional light), with a
   // constant background and with an environment map.
   const auto replaced = [](std::string text, const std::string& from, const std::string& to) {
@@ -425,6 +437,21 @@ TEST(GeometryGroups, GroupsABatchByGeometryMissesFirst) {
     for (size_t o = 0; o < n; ++o) {
       ASSERT_EQ(counting.order()[o], expected[o]) << "batch of " << n << ", position " << o;
       ASSERT_EQ(sorting.order()[o], expected[o]) << "batch of " << n << ", position " << o;
+    }
+    // The runs: consecutive, non-empty, each of one geometry and none two of the same.
+    for (const GeometryGroups* groups : {&counting, &sorting}) {
+      size_t covered = 0;
+      std::set<uint32_t> seen;
+      for (size_t r = 0; r < groups->runCount(); ++r) {
+        const GeometryGroups::Run run = groups->runs()[r];
+        ASSERT_EQ(run.begin, covered) << "batch of " << n << ", run " << r;
+        ASSERT_LT(run.begin, run.end) << "batch of " << n << ", run " << r;
+        ASSERT_TRUE(seen.insert(run.geometry).second) << "batch of " << n << ", run " << r;
+        for (size_t o = run.begin; o < run.end; ++o)
+          ASSERT_EQ(batch.geometryOf(expected[o]), run.geometry) << "batch of " << n << ", position " << o;
+        covered = run.end;
+      }
+      ASSERT_EQ(covered, n) << "batch of " << n;
     }
   }
 }
