@@ -1,11 +1,13 @@
 #include "packet/ray_batch.h"
 
+#include "packet/packet_fields.h"
 #include "packet/traceable_lanes.h"
 
 #include <algorithm>
 #include <bit>
 #include <cstdlib>
 #include <cstring>
+#include <iterator>
 #include <new>
 #include <stdexcept>
 
@@ -131,27 +133,30 @@ void ClosestHitBatch::assign(const std::array<const float*, 3>& origin,
                              const std::array<const float*, 3>& dir, const uint32_t* mask, size_t count) {
   if (count > storage_.capacity()) throw std::logic_error("ClosestHitBatch overflow");
   const unsigned n = storage_.width();
-  for (size_t first = 0; first < count; first += n) {
-    const size_t lanes = std::min<size_t>(n, count - first);
-    RTCRayHitN* p = packetOf(first);
-    RTCRayN* r = RTCRayHitN_RayN(p, n);
-    RTCHitN* h = RTCRayHitN_HitN(p, n);
-    const auto copy = [&](float& field, const float* row) {
-      std::memcpy(&field, row + first, lanes * sizeof(float));
-    };
-    copy(RTCRayN_org_x(r, n, 0), origin[0]);
-    copy(RTCRayN_org_y(r, n, 0), origin[1]);
-    copy(RTCRayN_org_z(r, n, 0), origin[2]);
-    copy(RTCRayN_dir_x(r, n, 0), dir[0]);
-    copy(RTCRayN_dir_y(r, n, 0), dir[1]);
-    copy(RTCRayN_dir_z(r, n, 0), dir[2]);
-    std::fill_n(&RTCRayN_tnear(r, n, 0), lanes, 0.0f);
-    std::fill_n(&RTCRayN_tfar(r, n, 0), lanes, kInfinity);
-    std::memcpy(&RTCRayN_mask(r, n, 0), mask + first, lanes * sizeof(uint32_t));
-    std::fill_n(&RTCHitN_geomID(h, n, 0), lanes, RTC_INVALID_GEOMETRY_ID);
-    std::fill_n(&RTCHitN_primID(h, n, 0), lanes, RTC_INVALID_GEOMETRY_ID);
-    std::fill_n(&RTCHitN_instID(h, n, 0, 0), lanes, RTC_INVALID_GEOMETRY_ID);
-  }
+  float* base = storage_.packet(0);
+  RTCRayHitN* p = packetOf(0);
+  RTCRayN* r = RTCRayHitN_RayN(p, n);
+  RTCHitN* h = RTCRayHitN_HitN(p, n);
+  const auto at = [base](const auto& field) {
+    return size_t(reinterpret_cast<const char*>(&field) - reinterpret_cast<const char*>(base)) /
+           sizeof(float);
+  };
+  const float invalid = std::bit_cast<float>(RTC_INVALID_GEOMETRY_ID);
+  const PacketFieldSource fields[] = {
+      {at(RTCRayN_org_x(r, n, 0)), origin[0], 0.0f},
+      {at(RTCRayN_org_y(r, n, 0)), origin[1], 0.0f},
+      {at(RTCRayN_org_z(r, n, 0)), origin[2], 0.0f},
+      {at(RTCRayN_dir_x(r, n, 0)), dir[0], 0.0f},
+      {at(RTCRayN_dir_y(r, n, 0)), dir[1], 0.0f},
+      {at(RTCRayN_dir_z(r, n, 0)), dir[2], 0.0f},
+      {at(RTCRayN_tnear(r, n, 0)), nullptr, 0.0f},
+      {at(RTCRayN_tfar(r, n, 0)), nullptr, kInfinity},
+      {at(RTCRayN_mask(r, n, 0)), reinterpret_cast<const float*>(mask), 0.0f},
+      {at(RTCHitN_geomID(h, n, 0)), nullptr, invalid},
+      {at(RTCHitN_primID(h, n, 0)), nullptr, invalid},
+      {at(RTCHitN_instID(h, n, 0, 0)), nullptr, invalid},
+  };
+  fillPacketFields(base, kFloatsPerRayHit * n, n, count, fields, std::size(fields));
   size_ = count;
 }
 

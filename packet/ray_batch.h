@@ -83,7 +83,8 @@ class ClosestHitBatch {
   void push(const Ray& ray, uint32_t mask = kAllRayMask);
   // Replaces the batch with `count` rays kept in rows (structure of arrays): ray i from
   // (origin[0][i], origin[1][i], origin[2][i]) along dir's, with Embree mask mask[i], as push
-  // makes it. Each field of a packet is copied from its row whole.
+  // makes it. Each field of a packet is copied from its row whole: the rows are read up to the
+  // next multiple of the width past count (packet/packet_fields.h).
   void assign(const std::array<const float*, 3>& origin, const std::array<const float*, 3>& dir,
               const uint32_t* mask, size_t count);
   void trace(const EmbreeAccel& accel, BatchTraversal traversal = BatchTraversal::Packets);
