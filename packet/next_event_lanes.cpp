@@ -5,6 +5,7 @@
 #include <hwy/highway.h>
 
 #include "core/math.h"
+#include "core/ray_spawn.h"
 #include "packet/next_event_lanes.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -34,14 +35,10 @@ HWY_INLINE V powerHeuristic(D d, V a, V b) {
   return hn::IfThenElseZero(hn::Gt(a, zero), w);
 }
 
-HWY_INLINE void storeMask(D d, M m, int32_t* out) {
-  const hn::RebindToSigned<D> di;
-  hn::Store(hn::BitCast(di, hn::VecFromMask(d, m)), di, out);
-}
-
-void NextEventKernel(NextEventArrays& a, size_t n) {
+size_t NextEventKernel(NextEventArrays& a, const uint32_t* maskFront, const uint32_t* maskBack, size_t n) {
   const D d;
   const V zero = hn::Zero(d);
+  size_t shadows = 0;
   for (size_t i = 0; i < n; i += hn::Lanes(d)) {
     const auto load = [&](const float* row) { return hn::Load(d, row + i); };
     const auto load3 = [&](const float(&rows)[3][NextEventArrays::kStride], V(&out)[3]) {
@@ -117,12 +114,8 @@ void NextEventKernel(NextEventArrays& a, size_t n) {
     const V pdf = hn::Mul(load(a.pmf), lightPdf);
     const V weight = hn::IfThenElse(delta, hn::Set(d, 1.0f), powerHeuristic(d, pdf, bsdfPdf));
     const V k = hn::Div(weight, pdf);
-    for (int c = 0; c < 3; ++c) {
-      hn::Store(origin[c], d, a.origin[c] + i);
-      hn::Store(dir[c], d, a.dir[c] + i);
+    for (int c = 0; c < 3; ++c)
       hn::Store(hn::Mul(tp[c], hn::Mul(hn::Mul(f[c], li[c]), k)), d, a.contribution[c] + i);
-    }
-    hn::Store(tMax, d, a.tMax + i);
 
     // SurfaceHit::maskToward: whether the target is off the tangent plane by more than both
     // points' errors and the dot product's rounding.
@@ -130,10 +123,27 @@ void NextEventKernel(NextEventArrays& a, size_t n) {
     // Towards an infinitely far light, the surface's own mask for the side (SurfaceHit::maskFor).
     const M clear = hn::Or(
         infinite, hn::Gt(hn::Abs(dDotNg), hn::Add(hn::Add(pError, lightPError), roundingErrorBound(d, sum))));
-    storeMask(d, ok, a.shadow + i);
-    storeMask(d, front, a.front + i);
-    storeMask(d, clear, a.clear + i);
+    const hn::RebindToUnsigned<D> du;
+    const auto surface = hn::IfThenElse(
+        hn::RebindMask(du, clear),
+        hn::IfThenElse(hn::RebindMask(du, front), hn::Load(du, maskFront + i), hn::Load(du, maskBack + i)),
+        hn::Set(du, kAllRayMask));
+
+    // The shadow rays of the vertices whose sample contributes, compacted.
+    const M shadow = hn::And(ok, hn::FirstN(d, n - i));
+    const auto put = [&](V value, float* row) { hn::StoreU(hn::Compress(value, shadow), d, row + shadows); };
+    for (int c = 0; c < 3; ++c) {
+      put(origin[c], a.shadowOrigin[c]);
+      put(dir[c], a.shadowDir[c]);
+    }
+    put(tMax, a.shadowTMax);
+    hn::StoreU(hn::Compress(hn::And(surface, hn::Load(du, a.lightMask + i)), hn::RebindMask(du, shadow)), du,
+               a.shadowMask + shadows);
+    hn::StoreU(hn::Compress(hn::Iota(di, int32_t(i)), hn::RebindMask(di, shadow)), di,
+               a.shadowVertex + shadows);
+    shadows += hn::CountTrue(d, shadow);
   }
+  return shadows;
 }
 
 }  // namespace ember::HWY_NAMESPACE
@@ -144,8 +154,8 @@ namespace ember {
 
 HWY_EXPORT(NextEventKernel);
 
-void nextEventLanes(NextEventArrays& a, size_t n) {
-  HWY_DYNAMIC_DISPATCH(NextEventKernel)(a, n);
+size_t nextEventLanes(NextEventArrays& a, const uint32_t* maskFront, const uint32_t* maskBack, size_t n) {
+  return HWY_DYNAMIC_DISPATCH(NextEventKernel)(a, maskFront, maskBack, n);
 }
 
 }  // namespace ember

@@ -46,18 +46,23 @@ struct NextEventArrays {
   // -1: the light is infinitely far (directional, environment): the shadow ray leaves in lightWi
   // with no end (PathIntegrator::shadowFor's infinite case), and lightP and lightN are not read.
   alignas(64) int32_t infinite[kStride] = {};
-  // Results: the shadow ray where `shadow` is -1, the side it leaves to (front: -1) and whether
-  // its target is clearly off the vertex's tangent plane (clear: -1; SurfaceHit::maskToward).
-  alignas(64) float origin[3][kStride] = {};
-  alignas(64) float dir[3][kStride] = {};
-  alignas(64) float tMax[kStride] = {};
+  // The Embree mask of the light's shadow rays (Light::shadowMask).
+  alignas(64) uint32_t lightMask[kStride] = {};
+  // Results. Per vertex: the unoccluded contribution. Per shadow ray, compacted in vertex order
+  // (the vertices whose sample contributes): the ray, its Embree mask (the surface's mask for the
+  // side it leaves to where its target is clearly off the tangent plane, SurfaceHit::maskToward,
+  // and the light's) and its vertex.
   alignas(64) float contribution[3][kStride] = {};
-  alignas(64) int32_t shadow[kStride] = {};
-  alignas(64) int32_t front[kStride] = {};
-  alignas(64) int32_t clear[kStride] = {};
+  alignas(64) float shadowOrigin[3][kStride] = {};
+  alignas(64) float shadowDir[3][kStride] = {};
+  alignas(64) float shadowTMax[kStride] = {};
+  alignas(64) uint32_t shadowMask[kStride] = {};
+  alignas(64) int32_t shadowVertex[kStride] = {};
 };
 
-// Computes the results of vertices [0, n).
-void nextEventLanes(NextEventArrays& a, size_t n);
+// Computes the results of vertices [0, n) and returns the number of shadow rays. maskFront and
+// maskBack: each vertex's surface masks for rays leaving to its front and back
+// (SurfaceHit::maskFor).
+size_t nextEventLanes(NextEventArrays& a, const uint32_t* maskFront, const uint32_t* maskBack, size_t n);
 
 }  // namespace ember

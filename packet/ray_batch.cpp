@@ -129,34 +129,48 @@ void ClosestHitBatch::push(const Ray& ray, uint32_t mask) {
   ++size_;
 }
 
+namespace {
+
+// A field's offset in floats from the start of its packet.
+size_t offsetOf(const void* field, const float* packet) {
+  return size_t(static_cast<const char*>(field) - reinterpret_cast<const char*>(packet)) / sizeof(float);
+}
+
+// The ray fields both batches fill from rows (RTCRayN at the start of `packet`, n lanes): the
+// origin, tnear 0, the direction, tfar (a row, or +infinity where tfar is null) and the mask.
+constexpr size_t kRayFieldSources = 9;
+std::array<PacketFieldSource, kRayFieldSources> rayFieldSources(float* packet, unsigned n,
+                                                                const std::array<const float*, 3>& origin,
+                                                                const std::array<const float*, 3>& dir,
+                                                                const float* tfar, const uint32_t* mask) {
+  RTCRayN* r = reinterpret_cast<RTCRayN*>(packet);
+  return {{{offsetOf(&RTCRayN_org_x(r, n, 0), packet), origin[0], 0.0f},
+           {offsetOf(&RTCRayN_org_y(r, n, 0), packet), origin[1], 0.0f},
+           {offsetOf(&RTCRayN_org_z(r, n, 0), packet), origin[2], 0.0f},
+           {offsetOf(&RTCRayN_dir_x(r, n, 0), packet), dir[0], 0.0f},
+           {offsetOf(&RTCRayN_dir_y(r, n, 0), packet), dir[1], 0.0f},
+           {offsetOf(&RTCRayN_dir_z(r, n, 0), packet), dir[2], 0.0f},
+           {offsetOf(&RTCRayN_tnear(r, n, 0), packet), nullptr, 0.0f},
+           {offsetOf(&RTCRayN_tfar(r, n, 0), packet), tfar, kInfinity},
+           {offsetOf(&RTCRayN_mask(r, n, 0), packet), reinterpret_cast<const float*>(mask), 0.0f}}};
+}
+
+}  // namespace
+
 void ClosestHitBatch::assign(const std::array<const float*, 3>& origin,
                              const std::array<const float*, 3>& dir, const uint32_t* mask, size_t count) {
   if (count > storage_.capacity()) throw std::logic_error("ClosestHitBatch overflow");
   const unsigned n = storage_.width();
   float* base = storage_.packet(0);
-  RTCRayHitN* p = packetOf(0);
-  RTCRayN* r = RTCRayHitN_RayN(p, n);
-  RTCHitN* h = RTCRayHitN_HitN(p, n);
-  const auto at = [base](const auto& field) {
-    return size_t(reinterpret_cast<const char*>(&field) - reinterpret_cast<const char*>(base)) /
-           sizeof(float);
-  };
+  RTCHitN* h = RTCRayHitN_HitN(packetOf(0), n);
   const float invalid = std::bit_cast<float>(RTC_INVALID_GEOMETRY_ID);
-  const PacketFieldSource fields[] = {
-      {at(RTCRayN_org_x(r, n, 0)), origin[0], 0.0f},
-      {at(RTCRayN_org_y(r, n, 0)), origin[1], 0.0f},
-      {at(RTCRayN_org_z(r, n, 0)), origin[2], 0.0f},
-      {at(RTCRayN_dir_x(r, n, 0)), dir[0], 0.0f},
-      {at(RTCRayN_dir_y(r, n, 0)), dir[1], 0.0f},
-      {at(RTCRayN_dir_z(r, n, 0)), dir[2], 0.0f},
-      {at(RTCRayN_tnear(r, n, 0)), nullptr, 0.0f},
-      {at(RTCRayN_tfar(r, n, 0)), nullptr, kInfinity},
-      {at(RTCRayN_mask(r, n, 0)), reinterpret_cast<const float*>(mask), 0.0f},
-      {at(RTCHitN_geomID(h, n, 0)), nullptr, invalid},
-      {at(RTCHitN_primID(h, n, 0)), nullptr, invalid},
-      {at(RTCHitN_instID(h, n, 0, 0)), nullptr, invalid},
-  };
-  fillPacketFields(base, kFloatsPerRayHit * n, n, count, fields, std::size(fields));
+  std::array<PacketFieldSource, kRayFieldSources + 3> fields;
+  const auto ray = rayFieldSources(base, n, origin, dir, nullptr, mask);
+  std::copy(ray.begin(), ray.end(), fields.begin());
+  fields[kRayFieldSources] = {offsetOf(&RTCHitN_geomID(h, n, 0), base), nullptr, invalid};
+  fields[kRayFieldSources + 1] = {offsetOf(&RTCHitN_primID(h, n, 0), base), nullptr, invalid};
+  fields[kRayFieldSources + 2] = {offsetOf(&RTCHitN_instID(h, n, 0, 0), base), nullptr, invalid};
+  fillPacketFields(base, kFloatsPerRayHit * n, n, count, fields.data(), fields.size());
   size_ = count;
 }
 
@@ -225,6 +239,16 @@ void ShadowBatch::push(const Ray& ray, uint32_t mask) {
   writeRay(packet, n, lane, ray);
   RTCRayN_mask(packet, n, lane) = mask;
   ++size_;
+}
+
+void ShadowBatch::assign(const std::array<const float*, 3>& origin, const std::array<const float*, 3>& dir,
+                         const float* tMax, const uint32_t* mask, size_t count) {
+  if (count > storage_.capacity()) throw std::logic_error("ShadowBatch overflow");
+  const unsigned n = storage_.width();
+  float* base = storage_.packet(0);
+  const auto fields = rayFieldSources(base, n, origin, dir, tMax, mask);
+  fillPacketFields(base, kFloatsPerRay * n, n, count, fields.data(), fields.size());
+  size_ = count;
 }
 
 void ShadowBatch::trace(const EmbreeAccel& accel, BatchTraversal traversal) {

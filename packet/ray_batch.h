@@ -125,6 +125,10 @@ class ShadowBatch {
   // Appends a ray blocked by anything on its open segment (0, ray.tMax) whose Embree mask shares
   // a bit with `mask` (all bits, or the surface's and the light's: ShadowRequest::mask).
   void push(const Ray& ray, uint32_t mask = kAllRayMask);
+  // Replaces the batch with `count` rays kept in rows, as ClosestHitBatch::assign: ray i from
+  // origin's, along dir's, over (0, tMax[i]), with Embree mask mask[i], as push makes it.
+  void assign(const std::array<const float*, 3>& origin, const std::array<const float*, 3>& dir,
+              const float* tMax, const uint32_t* mask, size_t count);
   void trace(const EmbreeAccel& accel, BatchTraversal traversal = BatchTraversal::Packets);
   bool occluded(size_t i) const {
     return RTCRayN_tfar(reinterpret_cast<RTCRayN*>(storage_.packetOf(i)), storage_.width(),

@@ -1,13 +1,18 @@
 // Ray batches: the vector check that takes untraceable rays out of Embree's packets
-// (packet/traceable_lanes.h) against accel/embree_accel.h's traceable(), ray by ray, on every
-// SIMD target built.
+// (packet/traceable_lanes.h) against accel/embree_accel.h's traceable(), ray by ray, and batches
+// filled from rows (assign, packet/packet_fields.h) against batches filled ray by ray (push), on
+// every SIMD target built.
 #include "accel/embree_accel.h"
 #include "core/rng.h"
+#include "core/sampling.h"
+#include "io/scene_loader.h"
+#include "packet/ray_batch.h"
 #include "packet/traceable_lanes.h"
 
 #include <gtest/gtest.h>
 
 #include "simd_targets.h"
+#include "test_paths.h"
 
 #include <bit>
 #include <cstdint>
@@ -83,6 +88,68 @@ TEST(RayBatch, UntraceableLanesEqualTheScalarCheckOnEveryTarget) {
       EXPECT_GT(untraceable, 50);
       EXPECT_LT(untraceable, int(kPackets * width) - 50);
     }
+  });
+}
+
+// Rays in rows (structure of arrays, padded to whole packets) give the same hits and occlusions
+// as the same rays pushed one at a time: batch sizes that end mid-packet, both widths, rays with
+// masks that skip some geometry, a few untraceable rays, shadow rays of every length.
+TEST(RayBatch, BatchesAssignedFromRowsTraceAsPushedOnEveryTarget) {
+  Scene scene = loadScene(test::sourcePath("scenes/cornell-point.json"));
+  scene.build();
+  forEachSimdTarget([&] {
+    for (const unsigned width : {8u, 16u})
+      for (const size_t count : {size_t(1), size_t(17), size_t(300), size_t(1024)}) {
+        SCOPED_TRACE(testing::Message() << "width " << width << ", " << count << " rays");
+        scene.setPacketWidth(width);
+        Rng rng(uint64_t(width), count);
+        const size_t padded = (count + 15) / 16 * 16;
+        std::vector<float> origin[3], dir[3], tMax(padded, 0.0f);
+        for (int k = 0; k < 3; ++k) origin[k].assign(padded, 0.0f), dir[k].assign(padded, 0.0f);
+        std::vector<uint32_t> mask(padded, kAllRayMask);
+        ClosestHitBatch pushed(1024, width), assigned(1024, width);
+        ShadowBatch pushedShadows(1024, width), assignedShadows(1024, width);
+        for (size_t i = 0; i < count; ++i) {
+          Ray ray{Vec3(rng.uniform() * 1.6f - 0.8f, rng.uniform() * 1.8f + 0.1f, rng.uniform() * 2.0f),
+                  sampleUniformSphere(Vec2(rng.uniform(), rng.uniform())), rng.uniform() * 3.0f};
+          if (i % 97 == 5) ray.origin.x = std::numeric_limits<float>::quiet_NaN();  // untraceable
+          mask[i] = i % 3 == 0 ? rng.nextU32() | 1u : kAllRayMask;
+          for (int k = 0; k < 3; ++k) origin[k][i] = ray.origin[k], dir[k][i] = ray.dir[k];
+          tMax[i] = ray.tMax;
+          pushedShadows.push(ray, mask[i]);
+          ray.tMax = kInfinity;
+          pushed.push(ray, mask[i]);
+        }
+        assigned.assign({origin[0].data(), origin[1].data(), origin[2].data()},
+                        {dir[0].data(), dir[1].data(), dir[2].data()}, mask.data(), count);
+        assignedShadows.assign({origin[0].data(), origin[1].data(), origin[2].data()},
+                               {dir[0].data(), dir[1].data(), dir[2].data()}, tMax.data(), mask.data(),
+                               count);
+        ASSERT_EQ(assigned.size(), count);
+        ASSERT_EQ(assignedShadows.size(), count);
+        for (ClosestHitBatch* batch : {&pushed, &assigned}) batch->trace(scene.accel());
+        for (ShadowBatch* batch : {&pushedShadows, &assignedShadows}) batch->trace(scene.accel());
+        size_t hits = 0, occluded = 0;
+        for (size_t i = 0; i < count; ++i) {
+          RawHit a, b;
+          const bool hitA = pushed.hit(i, a), hitB = assigned.hit(i, b);
+          ASSERT_EQ(hitA, hitB) << "ray " << i;
+          if (hitA) {
+            ++hits;
+            EXPECT_EQ(a.geomID, b.geomID) << "ray " << i;
+            EXPECT_EQ(a.primID, b.primID) << "ray " << i;
+            EXPECT_EQ(std::bit_cast<uint32_t>(a.t), std::bit_cast<uint32_t>(b.t)) << "ray " << i;
+          }
+          EXPECT_EQ(pushedShadows.occluded(i), assignedShadows.occluded(i)) << "shadow ray " << i;
+          occluded += pushedShadows.occluded(i);
+        }
+        if (count >= 300) {  // the rays must both hit and miss, and be both blocked and not
+          EXPECT_GT(hits, count / 4);
+          EXPECT_LT(hits, count);
+          EXPECT_GT(occluded, count / 10);
+          EXPECT_LT(occluded, count - count / 10);
+        }
+      }
   });
 }
 
