@@ -27,9 +27,11 @@ size_t ArriveLambertianKernel(const HitFields& hits, const PathArrays& paths, co
   const VI firstVertex = hn::Set(di, int32_t(run.firstVertex));
   size_t projected = 0;
   for (size_t i = 0; i < run.count; i += hn::Lanes(d)) {
-    // Lanes past the run gather slot 0's path, which exists, and write past the run's vertices.
+    // Lanes past the run repeat the run's first slot, whose ray hit this shape (so their values
+    // are finite, as the rows' padding lanes must be), and write past the run's vertices.
     const VI slot =
-        hn::IfThenElseZero(hn::FirstN(di, run.count - i), hn::PromoteTo(di, hn::LoadU(d16, run.slots + i)));
+        hn::IfThenElse(hn::FirstN(di, run.count - i), hn::PromoteTo(di, hn::LoadU(d16, run.slots + i)),
+                       hn::Set(di, int32_t(run.slots[0])));
     const VI inPacket =
         hn::Add(hn::Mul(hn::ShiftRightSame(slot, int(hits.shift)), stride), hn::And(slot, laneMask));
     const auto hit = [&](uint32_t field) { return hn::GatherIndex(d, hits.base + field, inPacket); };

@@ -24,7 +24,8 @@ namespace ember {
 
 // A run of paths that hit one shape, and the shape's constants.
 struct LambertianRun {
-  const uint16_t* slots;  // the paths' slots, in the order their vertices take
+  const uint16_t* slots;  // the paths' slots, in the order their vertices take; readable in
+                          // whole vectors, up to NextEventArrays::kBlock entries past count
   size_t count;
   size_t firstVertex;  // the run's vertices are [firstVertex, firstVertex + count)
   Color albedo;

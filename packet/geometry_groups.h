@@ -35,7 +35,10 @@ class GeometryGroups {
   size_t runCount() const { return runCount_; }
 
  private:
-  std::array<uint16_t, kMaxLanes> order_;
+  // Padded so that kernels may load order() in whole vectors of up to 16 past its end
+  // (packet/arrival_lanes.h).
+  static constexpr size_t kOrderPadding = 16;
+  std::array<uint16_t, kMaxLanes + kOrderPadding> order_{};
   std::array<uint32_t, kMaxLanes> key_;      // geomID + 1 of each batch index's hit, 0 for a miss
   std::array<uint64_t, kMaxLanes> sortKey_;  // (geomID + 1) << 16 | batch index, for many geometries
   std::array<Run, kMaxLanes> runs_;

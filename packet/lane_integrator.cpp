@@ -245,9 +245,9 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
       phases.mark(PathPhase::TraceClosest);
 
       // PathIntegrator::arrive for every path: its emission, or the environment's where it left
-      // the scene, and the vertices that scatter. A run of hits on a shape with a constant
-      // Lambertian reflectance arrives in the vector kernel (packet/arrival_lanes.h), every other
-      // hit one at a time.
+      // the scene, and the vertices that scatter. At unbounded depth (where every path goes on
+      // from a Lambertian vertex) a run of hits on a shape with a constant Lambertian reflectance
+      // arrives in the vector kernel (packet/arrival_lanes.h), every other hit one at a time.
       wave.groups.group(wave.closest, active, scene.geometryCount());
       size_t vertices = 0, lightDraws = 0;
       // PathIntegrator::arrive's emission at vertex point p, normal ng, for the path in slot s; a

@@ -13,7 +13,7 @@ namespace ember {
 
 // Structure of arrays over the bounce's vertices; index v is the vertex. Lanes past the count the
 // kernel is given are computed too, up to the next multiple of kBlock: they must hold finite
-// values (the arrays start zeroed), and their results are not read.
+// values (the arrays start zeroed), and their per-vertex results are not read.
 struct NextEventArrays {
   static constexpr size_t kCapacity = 1024;
   static constexpr size_t kBlock = 16;
@@ -62,7 +62,9 @@ struct NextEventArrays {
 
 // Computes the results of vertices [0, n) and returns the number of shadow rays. maskFront and
 // maskBack: each vertex's surface masks for rays leaving to its front and back
-// (SurfaceHit::maskFor).
+// (SurfaceHit::maskFor), 64-byte aligned rows readable up to the next multiple of kBlock past n.
+// The compacted rows' lanes past the count hold leftovers of the compression; the batches copy
+// them into the last packet's unused lanes, which ShadowBatch::trace then makes inactive.
 size_t nextEventLanes(NextEventArrays& a, const uint32_t* maskFront, const uint32_t* maskBack, size_t n);
 
 }  // namespace ember

@@ -264,9 +264,12 @@ TEST(LaneKernel, SameImageAsScalarOnTheScenesItCovers) {
   scene.settings.maxDepth = -1;
   for (bool caustics : {true, false}) {
     scene.settings.traceCaustics = caustics;
+    // Whole waves too (a 16 x 16 tile at 4 spp: 1,024 paths), so that runs reach the rows' end.
     forEachSimdTarget([&] {
-      expectKernelsAgree(
-          scene, caustics ? "unbounded depth, caustics traced" : "unbounded depth, caustics path-traced");
+      const std::string name =
+          caustics ? "unbounded depth, caustics traced" : "unbounded depth, caustics path-traced";
+      expectKernelsAgree(scene, name);
+      expectKernelsAgree(scene, name + ", whole waves", RenderCase{2, 16, 4});
     });
   }
   scene.settings.maxDepth = 7;
