@@ -13,9 +13,12 @@
 namespace ember {
 
 // Bound on the float rounding error of a point computed from data whose magnitude is at most `m`:
-// about 17 ulps of m, plus an absolute floor for points at the origin.
+// about 17 ulps of m, plus an absolute floor for points at the origin. The lane kernels take the
+// same bound from core/ray_spawn-inl.h.
+inline constexpr float kRoundingErrorPerMagnitude = 2e-6f;
+inline constexpr float kRoundingErrorFloor = 1e-7f;
 inline float roundingErrorBound(float m) {
-  return 2e-6f * m + 1e-7f;
+  return kRoundingErrorPerMagnitude * m + kRoundingErrorFloor;
 }
 
 // `p` pushed along the normal `n` by `error` to the side `dir` points to (Woo et al. 1996): large

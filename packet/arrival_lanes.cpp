@@ -4,6 +4,7 @@
 #include <hwy/foreach_target.h>  // must come before highway.h
 #include <hwy/highway.h>
 
+#include "core/ray_spawn-inl.h"
 #include "packet/arrival_lanes.h"
 
 #include <stdexcept>
@@ -56,7 +57,7 @@ size_t ArriveLambertianKernel(const HitFields& hits, const PathArrays& paths, co
       store(albedo[k], nee.albedo[k]);
       store(path(paths.throughput[k]), nee.throughput[k]);
     }
-    store(hn::Add(hn::Mul(hn::Set(d, 2e-6f), hn::Add(magnitude, t)), hn::Set(d, 1e-7f)), nee.pError);
+    store(roundingErrorBound(d, hn::Add(magnitude, t)), nee.pError);
     const auto far = hn::RebindMask(di, hn::And(hn::Gt(t, magnitude), hn::FirstN(d, run.count - i)));
     hn::CompressStore(hn::Add(firstVertex, hn::Iota(di, int32_t(i))), far, di, project + projected);
     projected += hn::CountTrue(di, far);

@@ -5,6 +5,7 @@
 #include <hwy/highway.h>
 
 #include "core/math.h"
+#include "core/ray_spawn-inl.h"
 #include "core/ray_spawn.h"
 #include "packet/next_event_lanes.h"
 
@@ -19,11 +20,6 @@ using M = hn::Mask<D>;
 // glm's dot of two vec3: (x + y) + z of the products.
 HWY_INLINE V dot3(const V (&a)[3], const V (&b)[3]) {
   return hn::Add(hn::Add(hn::Mul(a[0], b[0]), hn::Mul(a[1], b[1])), hn::Mul(a[2], b[2]));
-}
-
-// roundingErrorBound (core/ray_spawn.h): 2e-6 m + 1e-7.
-HWY_INLINE V roundingErrorBound(D d, V m) {
-  return hn::Add(hn::Mul(hn::Set(d, 2e-6f), m), hn::Set(d, 1e-7f));
 }
 
 // powerHeuristic (core/sampling.h) of densities a and b.

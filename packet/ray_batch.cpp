@@ -219,7 +219,7 @@ HitFields ClosestHitBatch::hitFields() const {
   RTCRayHitN* p = packetOf(0);
   RTCHitN* h = RTCRayHitN_HitN(p, n);
   const float* base = storage_.packet(0);
-  const auto offset = [base](const float& field) { return uint32_t(&field - base); };
+  const auto offset = [base](const float& field) { return uint32_t(offsetOf(&field, base)); };
   return HitFields{base,
                    uint32_t(std::countr_zero(n)),
                    n - 1,
