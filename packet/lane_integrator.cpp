@@ -99,14 +99,41 @@ void storeSample(NextEventArrays& nee, size_t v, const LightSample& ls) {
   nee.infinite[v] = std::isfinite(ls.dist) ? 0 : -1;
 }
 
-// An area light's samples (AreaLight::sampleBlocks) for the vertices `keys` name (their low 16
-// bits), read from and written to the next-event arrays; a vertex without a sample keeps lightPdf -1.
+// An area light's samples for the vertices `keys` name (their low 16 bits, increasing), read from
+// and written to the next-event arrays; a vertex without a sample keeps lightPdf -1. Blocks of
+// queries on consecutive vertices (the vertices of one shape's run are consecutive) take
+// AreaLight::sampleRows, which reads and writes the rows as whole vectors; the rest take
+// sampleBlocks, lane by lane.
 void sampleAreaLight(const AreaLight& light, const uint64_t* keys, size_t n, NextEventArrays& nee,
                      const Vec2* lightU) {
-  light.sampleBlocks(
-      n, [&](size_t q) { return load3(nee.p, keys[q] & 0xffffu); },
-      [&](size_t q) { return lightU[keys[q] & 0xffffu]; },
-      [&](size_t q, const LightSample& ls) { storeSample(nee, keys[q] & 0xffffu, ls); });
+  constexpr size_t kBlock = SolidAngleLanes::kMaxLanes;
+  const float* const refRows[3] = {nee.p[0], nee.p[1], nee.p[2]};
+  const LightSampleRows rows{{nee.lightP[0], nee.lightP[1], nee.lightP[2]},
+                             {nee.lightN[0], nee.lightN[1], nee.lightN[2]},
+                             {nee.lightWi[0], nee.lightWi[1], nee.lightWi[2]},
+                             {nee.lightLi[0], nee.lightLi[1], nee.lightLi[2]},
+                             nee.lightPError,
+                             nee.lightPdf,
+                             nee.delta,
+                             nee.infinite};
+  const auto consecutive = [&](size_t q) {
+    if (q + kBlock > n) return false;
+    for (size_t i = 1; i < kBlock; ++i)
+      if (keys[q + i] != keys[q] + i) return false;
+    return true;
+  };
+  for (size_t q = 0; q < n;) {
+    size_t end = q;
+    while (end < n && !consecutive(end)) ++end;
+    if (end > q)
+      light.sampleBlocks(
+          end - q, [&](size_t i) { return load3(nee.p, keys[q + i] & 0xffffu); },
+          [&](size_t i) { return lightU[keys[q + i] & 0xffffu]; },
+          [&](size_t i, const LightSample& ls) { storeSample(nee, keys[q + i] & 0xffffu, ls); });
+    for (; consecutive(end); end += kBlock)
+      light.sampleRows(refRows, lightU, size_t(keys[end] & 0xffffu), rows);
+    q = end;
+  }
 }
 
 // Samples every vertex's chosen light, one run of queries per light (sorted by light where that

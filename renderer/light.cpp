@@ -91,6 +91,17 @@ void AreaLight::sampleLanes(const Vec3* refs, const Vec2* us, size_t n, LightSam
       });
 }
 
+void AreaLight::sampleRows(const float* const refRows[3], const Vec2* us, size_t first,
+                           const LightSampleRows& rows) const {
+  SolidAngleLanes lanes;
+  const BackPlane back{planePoint_, planeNormal_, backMargin_};
+  const uint32_t live = loadSolidAngleRows(refRows, us, first, skipsBehind_ ? &back : nullptr, lanes);
+  if (live == 0) return;
+  lanes.n = SolidAngleLanes::kMaxLanes;
+  shape_->sampleSolidAngleLanes(lanes);
+  storeLightSampleRows(lanes, live, radiance_, twoSided_, pError_, rows, first);
+}
+
 bool AreaLight::fromShapeSample(const Vec3& ref, const ShapeSample& s, float pdf, LightSample& out) const {
   const Vec3 d = s.p - ref;
   const float dist = glm::length(d);

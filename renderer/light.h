@@ -134,6 +134,12 @@ class AreaLight final : public Light {
   // bit sample()'s; a query without one (behind the light, or no sample) gets no call.
   template <class RefOf, class UOf, class Sampled>
   void sampleBlocks(size_t n, RefOf refOf, UOf uOf, Sampled sampled) const;
+  // The samples of the kMaxLanes queries held at rows [first, first + kMaxLanes) of a caller that
+  // keeps them as rows (reference points in refRows, numbers in us), each written into `rows` at
+  // its own index: whole vectors in and out where sampleBlocks copies lane by lane. Bit for bit
+  // sample()'s; a query without a sample leaves its rows untouched.
+  void sampleRows(const float* const refRows[3], const Vec2* us, size_t first,
+                  const LightSampleRows& rows) const;
   // Lambertian emitter: Phi = pi * A * L per emitting side.
   Color power(float) const override { return (twoSided_ ? 2.0f : 1.0f) * kPi * shape_->area() * radiance_; }
   const Shape* shape() const { return shape_; }

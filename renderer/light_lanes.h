@@ -6,6 +6,7 @@
 #pragma once
 
 #include "accel/sampling_lanes.h"
+#include "core/math.h"
 
 #include <cstdint>
 
@@ -19,5 +20,38 @@ struct LightDirectionLanes {
 
 // For every lane of `lanes` (all kMaxLanes: pad the unused ones, as the sampling kernels need).
 void lightDirectionLanes(const SolidAngleLanes& lanes, LightDirectionLanes& out);
+
+// Light samples kept as rows (structure of arrays) at the caller's own indices, LightSample's
+// fields one row each: the packet integrator's next-event rows (packet/next_event_lanes.h).
+struct LightSampleRows {
+  float* p[3];
+  float* n[3];
+  float* wi[3];
+  float* Li[3];
+  float* pError;
+  float* pdf;
+  int32_t* delta;     // 0: an area light's sample is never a delta
+  int32_t* infinite;  // -1 where the distance is not finite
+};
+
+// The plane of a one-sided flat emitter, behind which a reference point sees only its back
+// (clearlyBehind in renderer/light.h).
+struct BackPlane {
+  Vec3 point, normal;
+  float margin;
+};
+
+// Fills all kMaxLanes lanes from rows [first, first + kMaxLanes): the reference points from
+// refRows, the numbers from us. Returns bit i set where lane i's point is not clearly behind
+// `back` (every bit when back is null); the other lanes get a copy of the lowest live lane, as
+// SolidAngleLanes::padFrom pads. No bit set: the lanes are left as loaded.
+uint32_t loadSolidAngleRows(const float* const refRows[3], const Vec2* us, size_t first,
+                            const BackPlane* back, SolidAngleLanes& lanes);
+
+// AreaLight::fillSample of each `live` lane whose sample exists (pdf > 0 and a non-zero distance),
+// stored into `rows` at first + lane, with the directions of lightDirectionLanes; the rows of the
+// other lanes are left untouched.
+void storeLightSampleRows(const SolidAngleLanes& lanes, uint32_t live, const Color& radiance, bool twoSided,
+                          float pError, const LightSampleRows& rows, size_t first);
 
 }  // namespace ember

@@ -4,6 +4,7 @@
 // equal bit for bit. The quad's kernel (SIMD inverse trigonometry) must also agree with the scalar
 // spherical-rectangle and area-sampling formulas it replaces, to float precision; its
 // distribution is checked by the chi-square tests of tests/test_chi2.cpp.
+#include "accel/cylinder.h"
 #include "accel/disc.h"
 #include "accel/flipped_shape.h"
 #include "accel/sphere.h"
@@ -268,6 +269,87 @@ TEST(SamplingLanes, AreaLightLanesEqualSingleSamples) {
     }
   }
   EXPECT_GT(sampledLights, 500u);
+}
+
+// AreaLight::sampleRows (the packet integrator's light samples for vertices held in rows) must
+// write each row exactly what sample() gives, and leave the rows of a reference without a sample
+// (behind a one-sided flat light, or none drawn) as they were. Checked on every SIMD target for
+// one- and two-sided quads, a flipped quad, a disc, and spheres and a cylinder with references
+// inside them (whose samples face away: Li black), from rows at offsets of whole blocks.
+void expectAreaLightRowsEqualSingleSamples() {
+  Rng rng(41, 7);
+  const std::array<Vec2, 4> uv = {Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)};
+  const QuadCase ceiling = quadCases()[0];
+  const Quad quad(ceiling.v, uv);
+  const FlippedShape flipped(std::make_unique<Quad>(ceiling.v, uv));
+  const Disc disc(Vec3(0.1f, 1.9f, 0.0f), Vec3(0.0f, -1.0f, 0.0f), 0.3f);
+  const Sphere sphere(Vec3(0.3f, 1.0f, -0.2f), 0.25f);
+  const Cylinder cylinder(Vec3(0.3f, 1.0f, -0.2f), Vec3(0.3f, 1.6f, -0.2f), 0.4f, /*caps=*/true);
+  const AreaLight lights[] = {AreaLight(&quad, Color(4.0f, 3.0f, 2.0f)),
+                              AreaLight(&quad, Color(1.0f), true),
+                              AreaLight(&flipped, Color(2.0f, 1.0f, 0.5f)),
+                              AreaLight(&disc, Color(3.0f)),
+                              AreaLight(&sphere, Color(2.0f)),
+                              AreaLight(&sphere, Color(2.0f), true),
+                              AreaLight(&cylinder, Color(0.5f, 1.0f, 2.0f))};
+  std::vector<Vec3> refs = referencePoints(ceiling.v, rng);
+  for (int i = 0; i < 40; ++i)  // inside the sphere and the cylinder
+    refs.push_back(Vec3(0.3f, 1.0f + 0.5f * rng.uniform(), -0.2f) + 0.2f * sampleUniformSphere(next2(rng)));
+  constexpr size_t kBlock = SolidAngleLanes::kMaxLanes;
+  const size_t n = (refs.size() + kBlock - 1) / kBlock * kBlock;
+  refs.resize(n, refs.front());
+  std::vector<Vec2> us(n);
+  std::vector<float> refRow[3];
+  for (int c = 0; c < 3; ++c) refRow[c].resize(n);
+  for (size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) refRow[c][i] = refs[i][c];
+  constexpr float kUntouched = -123.0f;
+  constexpr int32_t kUntouchedInt = 7;
+  size_t sampled = 0, black = 0;
+  for (const AreaLight& light : lights) {
+    for (Vec2& u : us) u = next2(rng);
+    std::vector<float> rowData[14];
+    for (auto& row : rowData) row.assign(n, kUntouched);
+    std::vector<int32_t> delta(n, kUntouchedInt), infinite(n, kUntouchedInt);
+    auto at = [&](int k) { return rowData[k].data(); };
+    const LightSampleRows rows{{at(0), at(1), at(2)},
+                               {at(3), at(4), at(5)},
+                               {at(6), at(7), at(8)},
+                               {at(9), at(10), at(11)},
+                               at(12),
+                               at(13),
+                               delta.data(),
+                               infinite.data()};
+    const float* const refRows[3] = {refRow[0].data(), refRow[1].data(), refRow[2].data()};
+    for (size_t first = 0; first < n; first += kBlock) light.sampleRows(refRows, us.data(), first, rows);
+    for (size_t i = 0; i < n; ++i) {
+      LightSample single;
+      if (!light.sample(refs[i], us[i], single)) {
+        for (int k = 0; k < 14; ++k) ASSERT_EQ(rowData[k][i], kUntouched) << i;
+        ASSERT_EQ(delta[i], kUntouchedInt);
+        ASSERT_EQ(infinite[i], kUntouchedInt);
+        continue;
+      }
+      ++sampled;
+      black += isBlack(single.Li);
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_EQ(single.p[c], rowData[0 + c][i]) << i;
+        EXPECT_EQ(single.n[c], rowData[3 + c][i]) << i;
+        EXPECT_EQ(single.wi[c], rowData[6 + c][i]) << i;
+        EXPECT_EQ(single.Li[c], rowData[9 + c][i]) << i;
+      }
+      EXPECT_EQ(single.pError, rowData[12][i]) << i;
+      EXPECT_EQ(single.pdf, rowData[13][i]) << i;
+      EXPECT_EQ(delta[i], 0);
+      EXPECT_EQ(infinite[i], std::isfinite(single.dist) ? 0 : -1);
+    }
+  }
+  EXPECT_GT(sampled, 1500u);
+  EXPECT_GT(black, 40u);  // facing away: the one-sided lights seen from inside
+}
+
+TEST(SamplingLanes, AreaLightRowsEqualSingleSamplesOnEveryTarget) {
+  forEachSimdTarget(expectAreaLightRowsEqualSingleSamples);
 }
 
 // A one-sided flat emitter skips the references behind it (AreaLight::seesOnlyBack) without sampling
