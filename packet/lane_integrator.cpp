@@ -7,12 +7,15 @@
 #include "packet/arrival_lanes.h"
 #include "packet/continuation_lanes.h"
 #include "packet/next_event_lanes.h"
+#include "packet/packet_fields.h"
 #include "packet/thread_wave.h"
 #include "packet/timed_trace.h"
 #include "renderer/sampler_lanes.h"
 
 #include <algorithm>
 #include <array>
+#include <bit>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <numeric>
@@ -99,6 +102,17 @@ void storeSample(NextEventArrays& nee, size_t v, const LightSample& ls) {
   nee.infinite[v] = std::isfinite(ls.dist) ? 0 : -1;
 }
 
+// Light queries are kept as keys (a light's index << 16 | vertex), increasing within a light's
+// run. A block of kSampleBlock queries on consecutive vertices reads and writes the next-event
+// rows as whole vectors.
+constexpr size_t kSampleBlock = SolidAngleLanes::kMaxLanes;
+bool consecutiveBlock(const uint64_t* keys, size_t q, size_t n) {
+  if (q + kSampleBlock > n) return false;
+  for (size_t i = 1; i < kSampleBlock; ++i)
+    if (keys[q + i] != keys[q] + i) return false;
+  return true;
+}
+
 // An area light's samples for the vertices `keys` name (their low 16 bits, increasing), read from
 // and written to the next-event arrays; a vertex without a sample keeps lightPdf -1. Blocks of
 // queries on consecutive vertices (the vertices of one shape's run are consecutive) take
@@ -106,7 +120,6 @@ void storeSample(NextEventArrays& nee, size_t v, const LightSample& ls) {
 // sampleBlocks, lane by lane.
 void sampleAreaLight(const AreaLight& light, const uint64_t* keys, size_t n, NextEventArrays& nee,
                      const Vec2* lightU) {
-  constexpr size_t kBlock = SolidAngleLanes::kMaxLanes;
   const float* const refRows[3] = {nee.p[0], nee.p[1], nee.p[2]};
   const LightSampleRows rows{{nee.lightP[0], nee.lightP[1], nee.lightP[2]},
                              {nee.lightN[0], nee.lightN[1], nee.lightN[2]},
@@ -116,12 +129,7 @@ void sampleAreaLight(const AreaLight& light, const uint64_t* keys, size_t n, Nex
                              nee.lightPdf,
                              nee.delta,
                              nee.infinite};
-  const auto consecutive = [&](size_t q) {
-    if (q + kBlock > n) return false;
-    for (size_t i = 1; i < kBlock; ++i)
-      if (keys[q + i] != keys[q] + i) return false;
-    return true;
-  };
+  const auto consecutive = [&](size_t q) { return consecutiveBlock(keys, q, n); };
   for (size_t q = 0; q < n;) {
     size_t end = q;
     while (end < n && !consecutive(end)) ++end;
@@ -130,9 +138,48 @@ void sampleAreaLight(const AreaLight& light, const uint64_t* keys, size_t n, Nex
           end - q, [&](size_t i) { return load3(nee.p, keys[q + i] & 0xffffu); },
           [&](size_t i) { return lightU[keys[q + i] & 0xffffu]; },
           [&](size_t i, const LightSample& ls) { storeSample(nee, keys[q + i] & 0xffffu, ls); });
-    for (; consecutive(end); end += kBlock)
+    for (; consecutive(end); end += kSampleBlock)
       light.sampleRows(refRows, lightU, size_t(keys[end] & 0xffffu), rows);
     q = end;
+  }
+}
+
+// A point light's samples for the vertices `keys` name: the next-event kernel takes each from the
+// light's position and intensity (renderer/light.cpp, samplePosition), which the vertices' rows
+// repeat. A block of queries on consecutive vertices is filled as whole vectors: the rows from
+// the block's first vertex on, seen as one packet of kSampleBlock lanes (packet/packet_fields.h).
+void samplePointLight(const PointLight& light, const uint64_t* keys, size_t n, NextEventArrays& nee) {
+  const Vec3 p = light.position();
+  const Color intensity = light.intensity();
+  const auto row = [](size_t offsetInBytes, int c = 0) {
+    return offsetInBytes / sizeof(float) + size_t(c) * NextEventArrays::kStride;
+  };
+  const PacketFieldSource fields[] = {
+      {row(offsetof(NextEventArrays, lightP), 0), nullptr, p.x},
+      {row(offsetof(NextEventArrays, lightP), 1), nullptr, p.y},
+      {row(offsetof(NextEventArrays, lightP), 2), nullptr, p.z},
+      {row(offsetof(NextEventArrays, lightLi), 0), nullptr, intensity.x},
+      {row(offsetof(NextEventArrays, lightLi), 1), nullptr, intensity.y},
+      {row(offsetof(NextEventArrays, lightLi), 2), nullptr, intensity.z},
+      {row(offsetof(NextEventArrays, lightN), 0), nullptr, 0.0f},
+      {row(offsetof(NextEventArrays, lightN), 1), nullptr, 0.0f},
+      {row(offsetof(NextEventArrays, lightN), 2), nullptr, 0.0f},
+      {row(offsetof(NextEventArrays, lightPError)), nullptr, 0.0f},
+      {row(offsetof(NextEventArrays, pointLight)), nullptr, std::bit_cast<float>(int32_t(-1))}};
+  float* const rows = reinterpret_cast<float*>(&nee);
+  for (size_t q = 0; q < n;) {
+    const size_t v = keys[q] & 0xffffu;
+    if (consecutiveBlock(keys, q, n)) {
+      fillPacketFields(rows + v, kSampleBlock, kSampleBlock, kSampleBlock, fields, std::size(fields));
+      q += kSampleBlock;
+      continue;
+    }
+    store3(nee.lightP, v, p);
+    store3(nee.lightLi, v, intensity);
+    store3(nee.lightN, v, Vec3(0.0f));
+    nee.lightPError[v] = 0.0f;
+    nee.pointLight[v] = -1;
+    ++q;
   }
 }
 
@@ -152,14 +199,7 @@ void sampleAreaLight(const AreaLight& light, const uint64_t* keys, size_t n, Nex
     if (const auto* area = dynamic_cast<const AreaLight*>(light)) {
       sampleAreaLight(*area, &wave.queryKey[first], end - first, wave.nee, wave.lightU.data());
     } else if (const auto* point = dynamic_cast<const PointLight*>(light)) {
-      for (size_t q = first; q < end; ++q) {  // the next-event kernel takes the sample
-        const size_t v = wave.queryKey[q] & 0xffffu;
-        store3(wave.nee.lightP, v, point->position());
-        store3(wave.nee.lightLi, v, point->intensity());
-        store3(wave.nee.lightN, v, Vec3(0.0f));
-        wave.nee.lightPError[v] = 0.0f;
-        wave.nee.pointLight[v] = -1;
-      }
+      samplePointLight(*point, &wave.queryKey[first], end - first, wave.nee);
     } else {
       for (size_t q = first; q < end; ++q) {
         const size_t v = wave.queryKey[q] & 0xffffu;
