@@ -102,9 +102,10 @@ void storeSample(NextEventArrays& nee, size_t v, const LightSample& ls) {
   nee.infinite[v] = std::isfinite(ls.dist) ? 0 : -1;
 }
 
-// Light queries are kept as keys (a light's index << 16 | vertex), increasing within a light's
-// run. A block of kSampleBlock queries on consecutive vertices reads and writes the next-event
-// rows as whole vectors.
+// Light queries are kept as keys (a light's index << 16 | vertex). Within a light's run they rise
+// with the vertex, and one shape's vertices are consecutive, so most of a run falls into blocks of
+// kSampleBlock queries on consecutive vertices, which read and write the next-event rows as whole
+// vectors. (Any order is correct; a block is found only where the keys rise one by one.)
 constexpr size_t kSampleBlock = SolidAngleLanes::kMaxLanes;
 bool consecutiveBlock(const uint64_t* keys, size_t q, size_t n) {
   if (q + kSampleBlock > n) return false;
@@ -113,7 +114,7 @@ bool consecutiveBlock(const uint64_t* keys, size_t q, size_t n) {
   return true;
 }
 
-// An area light's samples for the vertices `keys` name (their low 16 bits, increasing), read from
+// An area light's samples for the vertices `keys` name (their low 16 bits), read from
 // and written to the next-event arrays; a vertex without a sample keeps lightPdf -1. Blocks of
 // queries on consecutive vertices (the vertices of one shape's run are consecutive) take
 // AreaLight::sampleRows, which reads and writes the rows as whole vectors; the rest take
@@ -170,7 +171,8 @@ void samplePointLight(const PointLight& light, const uint64_t* keys, size_t n, N
   for (size_t q = 0; q < n;) {
     const size_t v = keys[q] & 0xffffu;
     if (consecutiveBlock(keys, q, n)) {
-      fillPacketFields(rows + v, kSampleBlock, kSampleBlock, kSampleBlock, fields, std::size(fields));
+      fillPacketFields(rows + v, /*stride=*/0, kSampleBlock, kSampleBlock, fields,
+                       std::size(fields));  // one packet
       q += kSampleBlock;
       continue;
     }

@@ -7,6 +7,8 @@
 #include "accel/float_lanes-inl.h"  // maskBits, namedLanes
 #include "renderer/light_lanes.h"
 
+#include <bit>
+
 HWY_BEFORE_NAMESPACE();
 namespace ember::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
@@ -79,7 +81,7 @@ uint32_t LoadSolidAngleRowsKernel(const float* const refRows[3], const Vec2* us,
   constexpr uint32_t kAll = (1u << SolidAngleLanes::kMaxLanes) - 1u;
   if (!back) return kAll;
   if (live == 0 || live == kAll) return live;
-  const unsigned model = unsigned(__builtin_ctz(live));
+  const unsigned model = unsigned(std::countr_zero(live));
   for (unsigned lane = 0; lane < SolidAngleLanes::kMaxLanes; ++lane)
     if (!((live >> lane) & 1u))
       lanes.set(lane, Vec3(lanes.ref[0][model], lanes.ref[1][model], lanes.ref[2][model]),
@@ -96,9 +98,10 @@ void StoreLightSampleRowsKernel(const SolidAngleLanes& lanes, uint32_t live, con
     auto at = [&](const float* p) { return hn::LoadU(d, p + i); };
     const Directions dirs = directionsAt(d, lanes, i);
     const V pdf = at(lanes.pdf);
-    // sampleBlocks: a lane has a sample where pdf > 0 and the distance is not 0.
-    const auto ok =
-        hn::And(namedLanes(d, live, unsigned(i)), hn::And(hn::Gt(pdf, zero), hn::Ne(dirs.dist, zero)));
+    // sampleBlocks: a lane has a sample where pdf > 0 and the distance is not 0 (a NaN distance
+    // included: Highway's Ne is an ordered compare on AVX2 and AVX-512, false for NaN).
+    const auto ok = hn::And(namedLanes(d, live, unsigned(i)),
+                            hn::And(hn::Gt(pdf, zero), hn::Not(hn::Eq(dirs.dist, zero))));
     const size_t at0 = first + i;
     auto put = [&](V v, float* row) { hn::BlendedStore(v, ok, d, row + at0); };
     for (int k = 0; k < 3; ++k) {

@@ -50,7 +50,7 @@ uint32_t loadSolidAngleRows(const float* const refRows[3], const Vec2* us, size_
 
 // AreaLight::fillSample of each `live` lane whose sample exists (pdf > 0 and a non-zero distance),
 // stored into `rows` at first + lane, with the directions of lightDirectionLanes; the rows of the
-// other lanes are left untouched.
+// other lanes keep their values (targets without masked stores read and write them back).
 void storeLightSampleRows(const SolidAngleLanes& lanes, uint32_t live, const Color& radiance, bool twoSided,
                           float pError, const LightSampleRows& rows, size_t first);
 

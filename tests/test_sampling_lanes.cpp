@@ -22,6 +22,8 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <bit>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -295,22 +297,32 @@ void expectAreaLightRowsEqualSingleSamples() {
   std::vector<Vec3> refs = referencePoints(ceiling.v, rng);
   for (int i = 0; i < 40; ++i)  // inside the sphere and the cylinder
     refs.push_back(Vec3(0.3f, 1.0f + 0.5f * rng.uniform(), -0.2f) + 0.2f * sampleUniformSphere(next2(rng)));
-  constexpr size_t kBlock = SolidAngleLanes::kMaxLanes;
-  const size_t n = (refs.size() + kBlock - 1) / kBlock * kBlock;
+  // So far away that the distance overflows, and not a point at all (its samples have a NaN
+  // distance: the rows' infinite flag).
+  for (const Vec3& far : {Vec3(3e38f, 1.0f, 0.0f), Vec3(0.0f, -1e30f, 2e30f), Vec3(-3e38f, -3e38f, 3e38f),
+                          Vec3(std::numeric_limits<float>::quiet_NaN(), 1.0f, 0.0f)})
+    refs.push_back(far);
+  // The queries start at an offset that is no multiple of the block, as a wave's runs do.
+  constexpr size_t kBlock = SolidAngleLanes::kMaxLanes, kOffset = 5;
+  const size_t n = (refs.size() + kBlock - 1) / kBlock * kBlock, rowSize = kOffset + n;
   refs.resize(n, refs.front());
-  std::vector<Vec2> us(n);
+  std::vector<Vec2> us(rowSize);
   std::vector<float> refRow[3];
-  for (int c = 0; c < 3; ++c) refRow[c].resize(n);
+  for (int c = 0; c < 3; ++c) refRow[c].assign(rowSize, 0.0f);
   for (size_t i = 0; i < n; ++i)
-    for (int c = 0; c < 3; ++c) refRow[c][i] = refs[i][c];
+    for (int c = 0; c < 3; ++c) refRow[c][kOffset + i] = refs[i][c];
   constexpr float kUntouched = -123.0f;
   constexpr int32_t kUntouchedInt = 7;
-  size_t sampled = 0, black = 0;
+  const auto bits = [](float x) { return std::bit_cast<uint32_t>(x); };
+  // Bit for bit, signed zeros included; a NaN equals any NaN (a NaN reference point's sample is
+  // NaN either way, and which NaN an operation on NaNs leaves is up to its instructions).
+  const auto same = [&](float a, float b) { return bits(a) == bits(b) || (std::isnan(a) && std::isnan(b)); };
+  size_t sampled = 0, black = 0, infinite = 0;
   for (const AreaLight& light : lights) {
     for (Vec2& u : us) u = next2(rng);
     std::vector<float> rowData[14];
-    for (auto& row : rowData) row.assign(n, kUntouched);
-    std::vector<int32_t> delta(n, kUntouchedInt), infinite(n, kUntouchedInt);
+    for (auto& row : rowData) row.assign(rowSize, kUntouched);
+    std::vector<int32_t> deltaRow(rowSize, kUntouchedInt), infiniteRow(rowSize, kUntouchedInt);
     auto at = [&](int k) { return rowData[k].data(); };
     const LightSampleRows rows{{at(0), at(1), at(2)},
                                {at(3), at(4), at(5)},
@@ -318,34 +330,39 @@ void expectAreaLightRowsEqualSingleSamples() {
                                {at(9), at(10), at(11)},
                                at(12),
                                at(13),
-                               delta.data(),
-                               infinite.data()};
+                               deltaRow.data(),
+                               infiniteRow.data()};
     const float* const refRows[3] = {refRow[0].data(), refRow[1].data(), refRow[2].data()};
-    for (size_t first = 0; first < n; first += kBlock) light.sampleRows(refRows, us.data(), first, rows);
+    for (size_t first = kOffset; first < rowSize; first += kBlock)
+      light.sampleRows(refRows, us.data(), first, rows);
+    for (size_t i = 0; i < kOffset; ++i) ASSERT_EQ(bits(rowData[13][i]), bits(kUntouched));
     for (size_t i = 0; i < n; ++i) {
+      const size_t r = kOffset + i;
       LightSample single;
-      if (!light.sample(refs[i], us[i], single)) {
-        for (int k = 0; k < 14; ++k) ASSERT_EQ(rowData[k][i], kUntouched) << i;
-        ASSERT_EQ(delta[i], kUntouchedInt);
-        ASSERT_EQ(infinite[i], kUntouchedInt);
+      if (!light.sample(refs[i], us[r], single)) {
+        for (int k = 0; k < 14; ++k) ASSERT_EQ(bits(rowData[k][r]), bits(kUntouched)) << i;
+        ASSERT_EQ(deltaRow[r], kUntouchedInt);
+        ASSERT_EQ(infiniteRow[r], kUntouchedInt);
         continue;
       }
       ++sampled;
       black += isBlack(single.Li);
+      infinite += !std::isfinite(single.dist);
       for (int c = 0; c < 3; ++c) {
-        EXPECT_EQ(single.p[c], rowData[0 + c][i]) << i;
-        EXPECT_EQ(single.n[c], rowData[3 + c][i]) << i;
-        EXPECT_EQ(single.wi[c], rowData[6 + c][i]) << i;
-        EXPECT_EQ(single.Li[c], rowData[9 + c][i]) << i;
+        EXPECT_PRED2(same, single.p[c], rowData[0 + c][r]) << i;
+        EXPECT_PRED2(same, single.n[c], rowData[3 + c][r]) << i;
+        EXPECT_PRED2(same, single.wi[c], rowData[6 + c][r]) << i;
+        EXPECT_PRED2(same, single.Li[c], rowData[9 + c][r]) << i;
       }
-      EXPECT_EQ(single.pError, rowData[12][i]) << i;
-      EXPECT_EQ(single.pdf, rowData[13][i]) << i;
-      EXPECT_EQ(delta[i], 0);
-      EXPECT_EQ(infinite[i], std::isfinite(single.dist) ? 0 : -1);
+      EXPECT_PRED2(same, single.pError, rowData[12][r]) << i;
+      EXPECT_PRED2(same, single.pdf, rowData[13][r]) << i;
+      EXPECT_EQ(deltaRow[r], 0);
+      EXPECT_EQ(infiniteRow[r], std::isfinite(single.dist) ? 0 : -1) << i;
     }
   }
   EXPECT_GT(sampled, 1500u);
-  EXPECT_GT(black, 40u);  // facing away: the one-sided lights seen from inside
+  EXPECT_GT(black, 40u);    // facing away: the one-sided lights seen from inside
+  EXPECT_GT(infinite, 0u);  // the NaN reference's samples: the rows' infinite flag
 }
 
 TEST(SamplingLanes, AreaLightRowsEqualSingleSamplesOnEveryTarget) {
