@@ -62,9 +62,7 @@ AreaLight::AreaLight(const Shape* shape, const Color& radiance, bool twoSided)
     const ShapeSample s = shape_->sampleArea(Vec2(0.5f));
     if (std::isfinite(glm::dot(s.p, s.n)) && std::abs(glm::length(s.n) - 1.0f) < 1e-3f) {
       skipsBehind_ = true;
-      planePoint_ = s.p;
-      planeNormal_ = s.n;
-      backMargin_ = 4.0f * pError_ + 1e-5f * maxAbsComponent(s.p);
+      back_ = BackPlane{s.p, s.n, 4.0f * pError_ + kClearlyBehindPerMagnitude * maxAbsComponent(s.p)};
     }
   }
 }
@@ -94,8 +92,7 @@ void AreaLight::sampleLanes(const Vec3* refs, const Vec2* us, size_t n, LightSam
 void AreaLight::sampleRows(const float* const refRows[3], const Vec2* us, size_t first,
                            const LightSampleRows& rows) const {
   SolidAngleLanes lanes;
-  const BackPlane back{planePoint_, planeNormal_, backMargin_};
-  const uint32_t live = loadSolidAngleRows(refRows, us, first, skipsBehind_ ? &back : nullptr, lanes);
+  const uint32_t live = loadSolidAngleRows(refRows, us, first, skipsBehind_ ? &back_ : nullptr, lanes);
   if (live == 0) return;
   lanes.n = SolidAngleLanes::kMaxLanes;
   shape_->sampleSolidAngleLanes(lanes);
@@ -136,7 +133,7 @@ TriangleLight::TriangleLight(const TriangleMesh* mesh, uint32_t prim, const Colo
       twoSided_(twoSided),
       pError_(mesh->pointError(prim)),
       area_(mesh->triangleArea(prim)),
-      backMargin_(4.0f * pError_ + 1e-5f * maxAbsComponent(v_[0])) {}
+      backMargin_(4.0f * pError_ + kClearlyBehindPerMagnitude * maxAbsComponent(v_[0])) {}
 
 float TriangleLight::pdf(const Vec3& ref, const Vec3& p, const Vec3& n) const {
   if (const auto st = sphericalTriangleForSampling(ref, v_[0], v_[1], v_[2], area_))

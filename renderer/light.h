@@ -117,7 +117,7 @@ class DirectionalLight final : public Light {
 // says so, as long as `margin` covers how far the samples may lie off the plane. Such a reference
 // gets no light sample: every one would carry Li = 0, which next-event estimation drops anyway.
 inline bool clearlyBehind(const Vec3& ref, const Vec3& point, const Vec3& n, float margin) {
-  return glm::dot(ref - point, n) < -(margin + 1e-5f * maxAbsComponent(ref));
+  return glm::dot(ref - point, n) < -(margin + kClearlyBehindPerMagnitude * maxAbsComponent(ref));
 }
 
 class AreaLight final : public Light {
@@ -150,7 +150,7 @@ class AreaLight final : public Light {
   // (Li black), so sampleLanes skips the lane and reports no sample, as shadowFor would have
   // discarded it. "Clearly" is a margin far above the rounding of the facing test.
   bool seesOnlyBack(const Vec3& ref) const {
-    return skipsBehind_ && clearlyBehind(ref, planePoint_, planeNormal_, backMargin_);
+    return skipsBehind_ && clearlyBehind(ref, back_.point, back_.normal, back_.margin);
   }
 
  private:
@@ -166,8 +166,7 @@ class AreaLight final : public Light {
   bool twoSided_;
   float pError_;              // rounding-error bound of the shape's sampled points
   bool skipsBehind_ = false;  // one-sided and flat: refs behind its plane see no light
-  Vec3 planePoint_{0.0f}, planeNormal_{0.0f};
-  float backMargin_ = 0.0f;
+  BackPlane back_{Vec3(0.0f), Vec3(0.0f), 0.0f};
 };
 
 class TriangleLight final : public Light {

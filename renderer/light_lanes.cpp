@@ -74,8 +74,8 @@ uint32_t LoadSolidAngleRowsKernel(const float* const refRows[3], const Vec2* us,
         dot3(dx, dy, dz, hn::Set(d, back->normal.x), hn::Set(d, back->normal.y), hn::Set(d, back->normal.z));
     const auto magnitude = hn::Max(hn::BitCast(du, hn::Abs(r[0])),
                                    hn::Max(hn::BitCast(du, hn::Abs(r[1])), hn::BitCast(du, hn::Abs(r[2]))));
-    const V limit =
-        hn::Neg(hn::Add(hn::Set(d, back->margin), hn::Mul(hn::Set(d, 1e-5f), hn::BitCast(d, magnitude))));
+    const V limit = hn::Neg(hn::Add(hn::Set(d, back->margin), hn::Mul(hn::Set(d, kClearlyBehindPerMagnitude),
+                                                                      hn::BitCast(d, magnitude))));
     live |= maskBits(d, hn::Not(hn::Lt(side, limit))) << i;
   }
   constexpr uint32_t kAll = (1u << SolidAngleLanes::kMaxLanes) - 1u;

@@ -34,6 +34,11 @@ struct LightSampleRows {
   int32_t* infinite;  // -1 where the distance is not finite
 };
 
+// How far behind the plane (beyond the margin) a reference point must lie, per unit of its
+// largest coordinate, to count as clearly behind: clearlyBehind in renderer/light.h and the
+// lanes of loadSolidAngleRows.
+inline constexpr float kClearlyBehindPerMagnitude = 1e-5f;
+
 // The plane of a one-sided flat emitter, behind which a reference point sees only its back
 // (clearlyBehind in renderer/light.h).
 struct BackPlane {
