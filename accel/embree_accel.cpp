@@ -57,7 +57,7 @@ static void meshOpacityFilter(const RTCFilterFunctionNArguments* args) {
   for (unsigned i = 0; i < args->N; ++i) {
     if (args->valid[i] != -1) continue;
     const uint32_t prim = RTCHitN_primID(args->hit, args->N, i);
-    const Vec2 uv = mesh->uvAt(prim, RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i));
+    const Vec2 b(RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i));
     uint32_t bits[7];
     const float ray[6] = {RTCRayN_org_x(args->ray, args->N, i), RTCRayN_org_y(args->ray, args->N, i),
                           RTCRayN_org_z(args->ray, args->N, i), RTCRayN_dir_x(args->ray, args->N, i),
@@ -67,7 +67,7 @@ static void meshOpacityFilter(const RTCFilterFunctionNArguments* args) {
     uint64_t h = 0x9e3779b97f4a7c15ull;
     for (uint32_t b : bits) h = mix64(h ^ b);
     const float u = float(h >> 40) * 0x1p-24f;
-    if (mesh->opacity->passesThrough(uv, u)) args->valid[i] = 0;
+    if (mesh->opacity->passesThrough(*mesh, prim, b, u)) args->valid[i] = 0;
   }
 }
 

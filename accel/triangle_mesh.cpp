@@ -28,6 +28,20 @@ Vec2 TriangleMesh::uvAt(uint32_t prim, float b1, float b2) const {
   return (1.0f - b1 - b2) * uvs[idx.x] + b1 * uvs[idx.y] + b2 * uvs[idx.z];
 }
 
+Vec2 TriangleMesh::texCoordAt(int set, uint32_t prim, Vec2 b) const {
+  if (set <= 0 || size_t(set) > texCoordSets.size() || texCoordSets[size_t(set) - 1].empty())
+    return uvAt(prim, b.x, b.y);
+  const std::vector<Vec2>& t = texCoordSets[size_t(set) - 1];
+  const glm::uvec3& idx = indices[prim];
+  return (1.0f - b.x - b.y) * t[idx.x] + b.x * t[idx.y] + b.y * t[idx.z];
+}
+
+glm::vec4 TriangleMesh::colorAt(uint32_t prim, Vec2 b) const {
+  if (colors.empty()) return glm::vec4(1.0f);
+  const glm::uvec3& idx = indices[prim];
+  return (1.0f - b.x - b.y) * colors[idx.x] + b.x * colors[idx.y] + b.y * colors[idx.z];
+}
+
 Vec3 TriangleMesh::pointAt(uint32_t prim, float b1, float b2) const {
   const glm::uvec3& idx = indices[prim];
   return pointOnTriangle(positions[idx.x], positions[idx.y], positions[idx.z], b1, b2);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "accel/shape.h"
+#include "core/vertex_attributes.h"
 
 #include <memory>
 #include <string>
@@ -11,15 +12,18 @@
 
 namespace ember {
 
-// Decides, inside Embree's traversal, whether a ray passes through the mesh at a hit.
+struct TriangleMesh;
+
+// Decides, inside Embree's traversal, whether a ray passes through the mesh at a hit, at
+// barycentrics b of triangle `prim`.
 class MeshOpacity {
  public:
   virtual ~MeshOpacity() = default;
   // `u` is uniform in [0, 1), a hash of the ray and the triangle, for stochastic transparency.
-  virtual bool passesThrough(Vec2 uv, float u) const = 0;
-  // The probability that a ray stops at uv: what light sampling weights an emitter's radiance by,
+  virtual bool passesThrough(const TriangleMesh& mesh, uint32_t prim, Vec2 b, float u) const = 0;
+  // The probability that a ray stops there: what light sampling weights an emitter's radiance by,
   // so that it agrees with the emission rays find through passesThrough.
-  virtual float coverage(Vec2 uv) const = 0;
+  virtual float coverage(const TriangleMesh& mesh, uint32_t prim, Vec2 b) const = 0;
 };
 
 // The point at barycentrics (b1, b2) of vertices p1 and p2 of triangle (p0, p1, p2): the one
@@ -29,12 +33,15 @@ inline Vec3 pointOnTriangle(const Vec3& p0, const Vec3& p1, const Vec3& p2, floa
   return (1.0f - b1 - b2) * p0 + b1 * p1 + b2 * p2;
 }
 
-struct TriangleMesh {
+struct TriangleMesh final : VertexAttributes {
   std::string name;
   std::vector<Vec3> positions;
   std::vector<Vec3> normals;        // empty, or one per position
-  std::vector<Vec2> uvs;            // empty, or one per position
+  std::vector<Vec2> uvs;            // empty, or one per position: TEXCOORD_0
   std::vector<glm::vec4> tangents;  // empty, or one per position: xyz and the bitangent sign w
+  // TEXCOORD_1, TEXCOORD_2, ...: texCoordSets[k] is set k + 1, each empty or one per position.
+  std::vector<std::vector<Vec2>> texCoordSets;
+  std::vector<glm::vec4> colors;  // empty, or one RGBA per position: COLOR_0
   std::vector<glm::uvec3> indices;
   std::shared_ptr<const MeshOpacity> opacity;  // null: opaque
 
@@ -47,6 +54,13 @@ struct TriangleMesh {
   // Surface attributes at barycentrics (b1, b2) of triangle `prim`.
   Surface surfaceAt(uint32_t prim, float b1, float b2) const;
   Vec2 uvAt(uint32_t prim, float b1, float b2) const;
+  // Texture coordinate sets beyond uvs count from 1; a set the mesh lacks reads as set 0 (the
+  // loader refuses materials that name one).
+  int texCoordSetCount() const { return 1 + int(texCoordSets.size()); }
+  Vec2 texCoordAt(int set, uint32_t prim, Vec2 b) const override;
+  glm::vec4 colorAt(uint32_t prim, Vec2 b) const override;
+  Vec3 normalAt(uint32_t prim, Vec2 b) const override { return surfaceAt(prim, b.x, b.y).ns; }
+  glm::vec4 tangentAt(uint32_t prim, Vec2 b) const override { return surfaceAt(prim, b.x, b.y).tangent; }
   // The point at barycentrics (b1, b2) of triangle `prim`, interpolated from its vertices, with the
   // rounding-error bound of points computed from them (core/ray_spawn.h).
   Vec3 pointAt(uint32_t prim, float b1, float b2) const;

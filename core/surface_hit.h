@@ -3,6 +3,7 @@
 
 #include "core/math.h"
 #include "core/ray_spawn.h"
+#include "core/vertex_attributes.h"
 
 #include <cstdint>
 
@@ -27,6 +28,16 @@ struct SurfaceHit {
   // Shape::convexSide); every bit otherwise.
   uint32_t maskFront = kAllRayMask, maskBack = kAllRayMask;
   bool twoSidedEmission = false;  // emits on both sides (glTF doubleSided)
+  // The mesh triangle the hit lies on, for the attributes few materials read (core/
+  // vertex_attributes.h); null on analytic shapes.
+  const VertexAttributes* attributes = nullptr;
+  uint32_t prim = 0;
+  Vec2 bary{0.0f};  // barycentrics (b1, b2) within triangle `prim`
+
+  // Texture coordinates of set `set`: uv for set 0, and on shapes without further sets.
+  Vec2 texCoord(int set) const { return set == 0 || !attributes ? uv : attributes->texCoordAt(set, prim, bary); }
+  // The vertex colour, white without one.
+  glm::vec4 vertexColor() const { return attributes ? attributes->colorAt(prim, bary) : glm::vec4(1.0f); }
 
   // Radiance the surface emits towards direction w: only on the side of ng unless two-sided.
   Color emitted(const Vec3& w) const {

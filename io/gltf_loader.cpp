@@ -133,6 +133,8 @@ class GltfImporter {
         "KHR_lights_punctual",        "KHR_materials_emissive_strength",
         "KHR_materials_transmission", "KHR_materials_ior",
         "KHR_materials_volume",       "KHR_texture_transform",
+        "KHR_materials_specular",     "KHR_materials_sheen",
+        "KHR_materials_clearcoat",
         "KHR_mesh_quantization"};
     return supported;
   }
@@ -592,15 +594,6 @@ class GltfImporter {
       fail(where + ".mode", "unknown primitive mode " + std::to_string(mode));
     const auto pos = prim.attributes.find("POSITION");
     if (pos == prim.attributes.end()) fail(where, "primitive has no POSITION attribute");
-    // Vertex colours multiply the base colour (glTF 2.0 section 3.7.2.1); Ember renders without
-    // them, and says so once per file, so that a grey render of a vertex-painted model is explained.
-    if (!warnedVertexColours_ && prim.attributes.count("COLOR_0")) {
-      warnedVertexColours_ = true;
-      std::fprintf(stderr,
-                   "ember: %s: %s.attributes.COLOR_0: vertex colours are not supported; the material's base "
-                   "colour is used without them\n",
-                   path_.c_str(), where.c_str());
-    }
     size_t vertexCount = 0;
     const std::vector<float> positions =
         readFloats(pos->second, TINYGLTF_TYPE_VEC3, where + ".attributes.POSITION", vertexCount);
@@ -637,6 +630,36 @@ class GltfImporter {
       mesh->uvs.resize(n);
       for (size_t i = 0; i < n; ++i) mesh->uvs[i] = Vec2(uvs[2 * i], uvs[2 * i + 1]);
     }
+    // TEXCOORD_1, TEXCOORD_2, ...: read up to the first set the primitive lacks (sets are numbered
+    // without gaps, glTF 2.0 section 3.7.2.1).
+    for (int set = 1;; ++set) {
+      const auto it = prim.attributes.find("TEXCOORD_" + std::to_string(set));
+      if (it == prim.attributes.end()) break;
+      const std::string w = where + ".attributes." + it->first;
+      size_t n = 0;
+      const std::vector<float> uvs = readFloats(it->second, TINYGLTF_TYPE_VEC2, w, n);
+      if (n != vertexCount) fail(w, "count differs from POSITION");
+      std::vector<Vec2>& out = mesh->texCoordSets.emplace_back(n);
+      for (size_t i = 0; i < n; ++i) out[i] = Vec2(uvs[2 * i], uvs[2 * i + 1]);
+    }
+    // COLOR_0 multiplies the base colour and its alpha (glTF 2.0 section 3.9.2): RGB or RGBA,
+    // float or normalised unsigned integers.
+    if (const auto col = prim.attributes.find("COLOR_0"); col != prim.attributes.end()) {
+      const std::string w = where + ".attributes.COLOR_0";
+      const tinygltf::Accessor& acc = checkedAccessor(col->second, w);
+      if (acc.type != TINYGLTF_TYPE_VEC3 && acc.type != TINYGLTF_TYPE_VEC4) fail(w, "expected a VEC3 or VEC4 accessor");
+      const int components = acc.type == TINYGLTF_TYPE_VEC4 ? 4 : 3;
+      size_t n = 0;
+      const std::vector<float> colors = readFloats(col->second, acc.type, w, n);
+      if (n != vertexCount) fail(w, "count differs from POSITION");
+      mesh->colors.resize(n);
+      for (size_t i = 0; i < n; ++i) {
+        const float* c = &colors[size_t(components) * i];
+        mesh->colors[i] = glm::clamp(glm::vec4(c[0], c[1], c[2], components == 4 ? c[3] : 1.0f), 0.0f, 1.0f);
+        if (!std::isfinite(c[0] + c[1] + c[2] + (components == 4 ? c[3] : 0.0f)))
+          fail(w, "non-finite colour at vertex " + std::to_string(i));
+      }
+    }
     if (const auto tan = prim.attributes.find("TANGENT");
         tan != prim.attributes.end() && !mesh->normals.empty()) {
       size_t n = 0;
@@ -669,7 +692,11 @@ class GltfImporter {
 
     result_.triangles += mesh->indices.size();
     ++result_.primitives;
-    const GltfSurface& surface = materials_.surface(prim.material);
+    const GltfSurface& surface = materials_.surface(prim.material, !mesh->colors.empty());
+    if (surface.maxTexCoord >= mesh->texCoordSetCount())
+      fail(surface.maxTexCoordWhere, "texCoord " + std::to_string(surface.maxTexCoord) + " names TEXCOORD_" +
+                                         std::to_string(surface.maxTexCoord) + ", which " + where + " does not have");
+    if (surface.needsTangents && mesh->tangents.empty()) mesh->generateTangents();
     const Material* material = surface.material;
     if (options_.materialOverride) {
       material = options_.materialOverride;
@@ -704,7 +731,6 @@ class GltfImporter {
   GltfImport result_;
   std::set<std::string> usedOverrides_;
   std::vector<PointsOrLines> pointsAndLines_;
-  bool warnedVertexColours_ = false;
 };
 
 }  // namespace

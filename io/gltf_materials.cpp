@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <cstring>
+#include <functional>
 
 namespace ember {
 
@@ -46,19 +47,65 @@ void GltfMaterialReader::warn(const std::string& where, const std::string& what)
   std::fprintf(stderr, "ember: %s: %s: %s\n", path_.c_str(), where.c_str(), what.c_str());
 }
 
-const GltfSurface& GltfMaterialReader::surface(int index) {
+const GltfSurface& GltfMaterialReader::surface(int index, bool vertexColors) {
   if (index < 0 || size_t(index) >= model_.materials.size()) index = -1;
-  if (const auto it = surfaces_.find(index); it != surfaces_.end()) return it->second;
-  return surfaces_[index] = convert(index);
+  const std::pair<int, bool> key(index, vertexColors);
+  if (const auto it = surfaces_.find(key); it != surfaces_.end()) return it->second;
+  GltfSurface& out = surfaces_[key];
+  out = convert(index, vertexColors);
+  converting_ = nullptr;
+  return out;
 }
 
-GltfSurface GltfMaterialReader::convert(int index) {
+std::shared_ptr<const Texture> GltfMaterialReader::extensionTexture(const tinygltf::Value& ext, const char* key,
+                                                                    Channels channels, const Color& scale,
+                                                                    const std::string& where, GltfSurface& out,
+                                                                    float* normalScale) {
+  (void)out;
+  if (!ext.Has(key)) return nullptr;
+  const std::string w = where + "." + key;
+  const tinygltf::Value& info = ext.Get(key);
+  if (!info.IsObject()) fail(w, "expected a textureInfo object");
+  const float tex = numberOr(info, "index", -1.0f);
+  if (!(tex >= 0.0f && tex < 1e9f)) fail(w + ".index", "expected a texture index");
+  const float texCoord = numberOr(info, "texCoord", 0.0f);
+  if (!(texCoord >= 0.0f && texCoord < 16.0f)) fail(w + ".texCoord", "expected 0..15");
+  if (normalScale) {
+    *normalScale = numberOr(info, "scale", 1.0f);
+    if (!std::isfinite(*normalScale)) fail(w + ".scale", "expected a number");
+  }
+  return texture(int(tex), int(texCoord), info.Has("extensions") ? extensionsOf(info) : tinygltf::ExtensionMap{},
+                 channels, scale, w);
+}
+
+namespace {
+
+// A factor array of `n` finite numbers (KHR extension colours), or `fallback` without one.
+Color colorFactor(const tinygltf::Value& ext, const char* key, const Color& fallback, const std::string& where,
+                  float maxValue, const std::function<void(const std::string&, const std::string&)>& fail) {
+  if (!ext.Has(key)) return fallback;
+  const tinygltf::Value& c = ext.Get(key);
+  if (!c.IsArray() || c.ArrayLen() != 3) fail(where + "." + key, "expected 3 numbers");
+  Color out;
+  for (int k = 0; k < 3; ++k) {
+    out[k] = c.Get(k).IsNumber() ? float(c.Get(k).GetNumberAsDouble()) : -1.0f;
+    if (!(out[k] >= 0.0f && out[k] <= maxValue))
+      fail(where + "." + key, "expected numbers in [0, " + (maxValue > 1e30f ? std::string("inf") : "1") + ")");
+  }
+  return out;
+}
+
+}  // namespace
+
+GltfSurface GltfMaterialReader::convert(int index, bool vertexColors) {
   GltfSurface out;
+  converting_ = &out;
   if (index < 0) {
     // The specification's default material (section 3.9.6): every property at its default, i.e.
     // a white, fully rough metal.
     GltfPbrInputs in;
     in.baseColor = std::make_shared<ConstantTexture>(Color(1.0f));
+    if (vertexColors) in.baseColor = std::make_shared<VertexColorTexture>(std::move(in.baseColor));
     in.metallicRoughness = std::make_shared<ConstantTexture>(Color(0.0f, 1.0f, 1.0f));
     out.material = scene_.addMaterial("(glTF default)", std::make_unique<GltfPbrMaterial>(std::move(in)));
     return out;
@@ -82,6 +129,8 @@ GltfSurface GltfMaterialReader::convert(int index) {
   const Color baseRgb(baseFactor);
   in.baseColor = texture(pbr.baseColorTexture, Channels::SrgbRgb, baseRgb, where + ".baseColorTexture");
   if (!in.baseColor) in.baseColor = std::make_shared<ConstantTexture>(baseRgb);
+  // COLOR_0 multiplies the base colour (glTF 2.0 section 3.9.2).
+  if (vertexColors) in.baseColor = std::make_shared<VertexColorTexture>(std::move(in.baseColor));
   const Color mr(0.0f, std::clamp(roughness, 0.0f, 1.0f), std::clamp(metallic, 0.0f, 1.0f));
   in.metallicRoughness = texture(pbr.metallicRoughnessTexture, Channels::MetallicRoughness, mr,
                                  where + ".metallicRoughnessTexture");
@@ -93,21 +142,56 @@ GltfSurface GltfMaterialReader::convert(int index) {
     if (!(factor >= 0.0f && factor <= 1.0f)) fail(w + ".transmissionFactor", "expected a number in [0, 1]");
     if (ext->Has("transmissionTexture")) {
       const tinygltf::Value& info = ext->Get("transmissionTexture");
-      const float tex = numberOr(info, "index", -1.0f);
-      if (!(tex >= 0.0f)) fail(w + ".transmissionTexture.index", "expected a texture index");
-      const float texCoord = numberOr(info, "texCoord", 0.0f);
-      if (!(texCoord >= 0.0f && texCoord < 16.0f))
-        fail(w + ".transmissionTexture.texCoord", "expected 0..15");
-      in.transmission = texture(int(tex), int(texCoord),
-                                info.Has("extensions") ? extensionsOf(info) : tinygltf::ExtensionMap{},
-                                Channels::Red, Color(factor), w + ".transmissionTexture");
+      (void)info;
+      in.transmission = extensionTexture(*ext, "transmissionTexture", Channels::Red, Color(factor), w, out);
     }
     if (!in.transmission && factor > 0.0f) in.transmission = std::make_shared<ConstantTexture>(Color(factor));
   }
   if (const tinygltf::Value* ext = extension(m.extensions, "KHR_materials_ior")) {
     in.ior = numberOr(*ext, "ior", 1.5f);
-    if (!(in.ior >= 1.0f && in.ior < 10.0f))
-      fail(where + ".extensions.KHR_materials_ior.ior", "expected a number in [1, 10)");
+    // 0 is allowed too: a dielectric that reflects totally, for specular-glossiness conversions.
+    if (!((in.ior >= 1.0f && in.ior < 10.0f) || in.ior == 0.0f))
+      fail(where + ".extensions.KHR_materials_ior.ior", "expected 0 or a number in [1, 10)");
+  }
+  const auto failAt = [this](const std::string& w, const std::string& what) { fail(w, what); };
+  // KHR_materials_specular: the strength in the texture's alpha, the colour (sRGB) in its RGB.
+  if (const tinygltf::Value* ext = extension(m.extensions, "KHR_materials_specular")) {
+    const std::string w = where + ".extensions.KHR_materials_specular";
+    const float factor = numberOr(*ext, "specularFactor", 1.0f);
+    if (!(factor >= 0.0f && factor <= 1.0f)) fail(w + ".specularFactor", "expected a number in [0, 1]");
+    const Color color = colorFactor(*ext, "specularColorFactor", Color(1.0f), w, 1e38f, failAt);
+    in.specular = extensionTexture(*ext, "specularTexture", Channels::Alpha, Color(factor), w, out);
+    if (!in.specular && factor != 1.0f) in.specular = std::make_shared<ConstantTexture>(Color(factor));
+    in.specularColor = extensionTexture(*ext, "specularColorTexture", Channels::SrgbRgb, color, w, out);
+    if (!in.specularColor && color != Color(1.0f)) in.specularColor = std::make_shared<ConstantTexture>(color);
+  }
+  // KHR_materials_sheen: colour (sRGB RGB) and roughness (alpha) textures.
+  if (const tinygltf::Value* ext = extension(m.extensions, "KHR_materials_sheen")) {
+    const std::string w = where + ".extensions.KHR_materials_sheen";
+    const Color color = colorFactor(*ext, "sheenColorFactor", Color(0.0f), w, 1.0f, failAt);
+    const float roughness = numberOr(*ext, "sheenRoughnessFactor", 0.0f);
+    if (!(roughness >= 0.0f && roughness <= 1.0f)) fail(w + ".sheenRoughnessFactor", "expected a number in [0, 1]");
+    in.sheenColor = extensionTexture(*ext, "sheenColorTexture", Channels::SrgbRgb, color, w, out);
+    if (!in.sheenColor && !isBlack(color)) in.sheenColor = std::make_shared<ConstantTexture>(color);
+    in.sheenRoughness = extensionTexture(*ext, "sheenRoughnessTexture", Channels::Alpha, Color(roughness), w, out);
+    if (!in.sheenRoughness) in.sheenRoughness = std::make_shared<ConstantTexture>(Color(roughness));
+  }
+  // KHR_materials_clearcoat: weight (R), roughness (G) and a normal map of the coat's own.
+  if (const tinygltf::Value* ext = extension(m.extensions, "KHR_materials_clearcoat")) {
+    const std::string w = where + ".extensions.KHR_materials_clearcoat";
+    const float factor = numberOr(*ext, "clearcoatFactor", 0.0f);
+    if (!(factor >= 0.0f && factor <= 1.0f)) fail(w + ".clearcoatFactor", "expected a number in [0, 1]");
+    const float roughness = numberOr(*ext, "clearcoatRoughnessFactor", 0.0f);
+    if (!(roughness >= 0.0f && roughness <= 1.0f))
+      fail(w + ".clearcoatRoughnessFactor", "expected a number in [0, 1]");
+    in.clearcoat = extensionTexture(*ext, "clearcoatTexture", Channels::Red, Color(factor), w, out);
+    if (!in.clearcoat && factor > 0.0f) in.clearcoat = std::make_shared<ConstantTexture>(Color(factor));
+    in.clearcoatRoughness =
+        extensionTexture(*ext, "clearcoatRoughnessTexture", Channels::Green, Color(roughness), w, out);
+    if (!in.clearcoatRoughness) in.clearcoatRoughness = std::make_shared<ConstantTexture>(Color(roughness));
+    in.clearcoatNormal = extensionTexture(*ext, "clearcoatNormalTexture", Channels::LinearRgb, Color(1.0f), w, out,
+                                          &in.clearcoatNormalScale);
+    out.needsTangents = in.clearcoatNormal != nullptr;
   }
   if (const tinygltf::Value* ext = extension(m.extensions, "KHR_materials_volume")) {
     const float thickness = numberOr(*ext, "thicknessFactor", 0.0f);
@@ -133,7 +217,8 @@ GltfSurface GltfMaterialReader::convert(int index) {
       for (int k = 0; k < 3; ++k)  // a colour of 0 absorbs everything: a large finite coefficient
         in.absorption[k] = color[k] > 0.0f ? -std::log(color[k]) / distance : 1e30f;
   }
-  const std::string name = m.name.empty() ? "material" + std::to_string(index) : m.name;
+  std::string name = m.name.empty() ? "material" + std::to_string(index) : m.name;
+  if (vertexColors) name += " (COLOR_0)";
   out.material = scene_.addMaterial(name, std::make_unique<GltfPbrMaterial>(in));
 
   // Emission: emissiveFactor x KHR_materials_emissive_strength, unscaled (Blender writes both so).
@@ -174,7 +259,8 @@ GltfSurface GltfMaterialReader::convert(int index) {
         texture(pbr.baseColorTexture, Channels::Alpha, Color(baseFactor.w), where + ".baseColorTexture");
     const bool opaque = mode == AlphaMode::Mask ? baseFactor.w >= cutoff : baseFactor.w >= 1.0f;
     if (!alpha && !opaque) alpha = std::make_shared<ConstantTexture>(Color(baseFactor.w));
-    if (alpha) out.opacity = std::make_shared<AlphaOpacity>(std::move(alpha), mode, cutoff);
+    if (!alpha && vertexColors) alpha = std::make_shared<ConstantTexture>(Color(baseFactor.w));
+    if (alpha) out.opacity = std::make_shared<AlphaOpacity>(std::move(alpha), mode, cutoff, vertexColors);
   } else if (alphaMode != "OPAQUE") {
     fail(where + ".alphaMode", "unknown alpha mode '" + alphaMode + "'; valid: OPAQUE, MASK, BLEND");
   }
@@ -221,6 +307,9 @@ std::shared_ptr<const Texture> GltfMaterialReader::texture(int index, int texCoo
       case Channels::Red:
         texels[i] = Color(rgb.x);
         break;
+      case Channels::Green:
+        texels[i] = Color(ch >= 3 ? rgb.y : rgb.x);
+        break;
     }
   }
   TextureWrap wrapS = TextureWrap::Repeat, wrapT = TextureWrap::Repeat;
@@ -256,8 +345,11 @@ std::shared_ptr<const Texture> GltfMaterialReader::texture(int index, int texCoo
     }
     out = std::make_shared<UvTransformTexture>(std::move(out), offset, rotation, scaleUv);
   }
-  if (texCoord != 0)
-    warn(where, "uses TEXCOORD_" + std::to_string(texCoord) + "; Ember reads TEXCOORD_0 only");
+  if (texCoord != 0) out = std::make_shared<TexCoordSetTexture>(std::move(out), texCoord);
+  if (converting_ && texCoord > converting_->maxTexCoord) {
+    converting_->maxTexCoord = texCoord;
+    converting_->maxTexCoordWhere = where;
+  }
   return out;
 }
 

@@ -16,6 +16,11 @@ namespace ember {
 
 struct GltfSurface {
   const Material* material = nullptr;
+  // The highest texture coordinate set a texture of the material reads, and where: a primitive
+  // without that TEXCOORD_n cannot use the material.
+  int maxTexCoord = 0;
+  std::string maxTexCoordWhere;
+  bool needsTangents = false;  // a normal map other than the surface's own reads tangents (the coat's)
   Color emission{0.0f};      // emissiveFactor x emissiveStrength
   bool doubleSided = false;  // both faces emit (and are shaded with the normal facing the viewer)
   std::shared_ptr<const SurfaceMaps> maps;
@@ -28,16 +33,22 @@ class GltfMaterialReader {
       : model_(model), path_(path), scene_(scene) {}
 
   // The surface for material index `index` (-1 or out of range: the spec's default material).
-  const GltfSurface& surface(int index);
+  // `vertexColors`: the primitive has COLOR_0, which multiplies the base colour and its alpha;
+  // the two uses of a material get a surface each.
+  const GltfSurface& surface(int index, bool vertexColors = false);
 
  private:
   struct Decoded {  // an image's channels as floats in [0, 1], not yet colour-decoded
     int width = 0, height = 0, channels = 0;
     std::vector<float> values;
   };
-  enum class Channels { SrgbRgb, LinearRgb, Alpha, MetallicRoughness, Red };
+  enum class Channels { SrgbRgb, LinearRgb, Alpha, MetallicRoughness, Red, Green };
 
-  GltfSurface convert(int index);
+  GltfSurface convert(int index, bool vertexColors);
+  // The textureInfo `key` of an extension object (a plain JSON value), or null without one.
+  std::shared_ptr<const Texture> extensionTexture(const tinygltf::Value& ext, const char* key, Channels channels,
+                                                  const Color& scale, const std::string& where, GltfSurface& out,
+                                                  float* normalScale = nullptr);
   std::shared_ptr<const Texture> texture(const tinygltf::TextureInfo& info, Channels channels,
                                          const Color& scale, const std::string& where);
   std::shared_ptr<const Texture> texture(int index, int texCoord, const tinygltf::ExtensionMap& extensions,
@@ -49,7 +60,8 @@ class GltfMaterialReader {
   const tinygltf::Model& model_;
   std::string path_;
   Scene& scene_;
-  std::map<int, GltfSurface> surfaces_;
+  std::map<std::pair<int, bool>, GltfSurface> surfaces_;
+  GltfSurface* converting_ = nullptr;  // the surface convert() is filling: texture() notes its sets
   std::map<int, Decoded> images_;
 };
 

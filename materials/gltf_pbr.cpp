@@ -1,5 +1,5 @@
-// glTF 2.0 metallic-roughness BRDF (specification Appendix B) with KHR_materials_transmission and
-// KHR_materials_ior. The formulas are in gltf_pbr.h; the choices the specification leaves open:
+// glTF 2.0 metallic-roughness BRDF (specification Appendix B) with the Khronos material extensions.
+// The formulas are in gltf_pbr.h; the choices the specification leaves open:
 //
 //  - Inputs: a missing baseColor or metallicRoughness texture means glTF's default factors (1);
 //    roughness, metallic and transmission are clamped to [0, 1], the base colour to >= 0, ior to
@@ -25,12 +25,24 @@
 //    Fresnel of fresnel.h on that side, it gives a refracting pair (wo, wi) the same F from both
 //    sides, so the BTDF obeys the generalised reciprocity f(wo, wi) / eta_i^2 = f(wi, wo) / eta_o^2
 //    exactly and stays continuous with the specification's Schlick on the outside.
+//  - KHR_materials_specular: the dielectric's Fresnel is a colour, Fr = schlick(f0 = min(f0_ior
+//    specularColor, 1), f90 = 1), the specular lobe weighted by w Fr and the base by
+//    1 - w max3(Fr) (the extension's fresnel_mix); the metal is unchanged. Inside a refracting
+//    volume Fr is taken as below, per channel. An ior of 0 (allowed for specular-glossiness
+//    conversions) means f0 = 1.
+//  - KHR_materials_sheen and _clearcoat layer over the whole base, transmission included, and only
+//    where wo is not inside a refracting volume (they are coatings of the outer surface). The coat
+//    weight uses n_c.v, as the extension defines it, so the coated BSDF is not reciprocal.
+//    Emission under a coat is not darkened by it (the extension suggests so; Ember's emission is the
+//    surface's, read before any material).
 //  - Sampling: a one-sample mixture of cosine-weighted diffuse, GGX visible normals (Heitz 2018)
-//    reflected, and (transmission > 0) the same visible normal refracted or reflected-and-mirrored.
-//    Lobe probabilities are proportional to cheap weight estimates with the Fresnel term at n.v
-//    (capped at 0.9):
-//    specular (1 - m) F_d + m max(F_m), diffuse (1 - m)(1 - F_d)(1 - t) max(baseColor),
-//    transmission (1 - m)(1 - F_d) t max(baseColor). Every strategy reports the full mixture pdf,
+//    reflected, (transmission > 0) the same visible normal refracted or reflected-and-mirrored,
+//    uniform hemisphere directions for the sheen and the coat's own visible normals. Lobe
+//    probabilities are proportional to cheap weight estimates with the Fresnel terms at n.v (the
+//    dielectric's capped at 0.9): coat c F_c, sheen (1 - c F_c) max(sheen) E, and under them
+//    (1 - c F_c)(1 - max(sheen) E) times: specular (1 - m) w F_d + m max(F_m), diffuse
+//    (1 - m)(1 - w F_d)(1 - t) max(baseColor), transmission (1 - m)(1 - w F_d) t max(baseColor).
+//    Every strategy reports the full mixture pdf,
 //    and the weight is eval / pdf, so sample(), eval() and pdf() agree exactly. A sampled direction
 //    that leaves its lobe's side (a reflected visible normal under the horizon, total internal
 //    reflection of a refraction sample) is absorbed: such directions carry no single-scattering
@@ -46,60 +58,125 @@
 #include "core/sampling.h"
 #include "materials/fresnel.h"
 #include "materials/hit_memo.h"
+#include "materials/sheen.h"
+#include "materials/surface_maps.h"
 
 namespace ember {
 
+namespace {
+
+// KHR_materials_clearcoat's layer is a dielectric of ior 1.5: f0 = ((1.5 - 1) / (1.5 + 1))^2.
+constexpr float kCoatF0 = 0.04f;
+
+float maxOf(const Color& c) { return std::max(c.x, std::max(c.y, c.z)); }
+
+}  // namespace
+
 GltfPbrMaterial::GltfPbrMaterial(GltfPbrInputs inputs) : inputs_(std::move(inputs)), id_(newHitMemoOwner()) {
-  ior_ = std::max(inputs_.ior, 1.0f);
-  const float r = (ior_ - 1.0f) / (ior_ + 1.0f);
-  f0_ = r * r;  // 0.04 at ior 1.5 (glTF B.3.4, KHR_materials_ior)
+  if (inputs_.ior == 0.0f) {
+    ior_ = 1.0f;
+    f0_ = 1.0f;  // ((0 - 1) / (0 + 1))^2
+  } else {
+    ior_ = std::max(inputs_.ior, 1.0f);
+    const float r = (ior_ - 1.0f) / (ior_ + 1.0f);
+    f0_ = r * r;  // 0.04 at ior 1.5 (glTF B.3.4, KHR_materials_ior)
+  }
   refracts_ = !inputs_.thinWalled && ior_ > 1.0f + 1e-3f;
+  sheen_ = inputs_.sheenColor && !isBlack(inputs_.sheenColor->maxValue());
+  coat_ = inputs_.clearcoat && inputs_.clearcoat->maxValue().x > 0.0f;
 }
 
 const GltfPbrMaterial::Params& GltfPbrMaterial::fetchFor(const SurfaceHit& hit) const {
-  return HitMemo<Params, GltfPbrMaterial>::at(hit, id_, [&] { return fetch(hit.uv); });
+  return HitMemo<Params, GltfPbrMaterial>::at(hit, id_, [&] { return fetch(hit); });
 }
 
-GltfPbrMaterial::Params GltfPbrMaterial::fetch(Vec2 uv) const {
-  Params p{Color(1.0f), 1.0f, 0.0f, Ggx::fromRoughness(1.0f)};
-  if (inputs_.baseColor) p.baseColor = glm::max(inputs_.baseColor->eval(uv), Color(0.0f));
+GltfPbrMaterial::Params GltfPbrMaterial::fetch(const SurfaceHit& hit) const {
+  Params p;
+  p.baseColor = Color(1.0f);
+  p.metallic = 1.0f;
+  if (inputs_.baseColor) p.baseColor = glm::max(inputs_.baseColor->evalAt(hit), Color(0.0f));
   if (inputs_.metallicRoughness) {
-    const Color mr = inputs_.metallicRoughness->eval(uv);
+    const Color mr = inputs_.metallicRoughness->evalAt(hit);
     p.ggx = Ggx::fromRoughness(std::clamp(mr.g, 0.0f, 1.0f));
     p.metallic = std::clamp(mr.b, 0.0f, 1.0f);
   }
-  if (inputs_.transmission) p.transmission = std::clamp(inputs_.transmission->eval(uv).r, 0.0f, 1.0f);
+  if (inputs_.transmission) p.transmission = std::clamp(inputs_.transmission->evalAt(hit).r, 0.0f, 1.0f);
+  const Color specularColor = inputs_.specularColor ? glm::max(inputs_.specularColor->evalAt(hit), Color(0.0f))
+                                                    : Color(1.0f);
+  p.specularF0 = glm::min(f0_ * specularColor, Color(1.0f));
+  if (inputs_.specular) p.specularWeight = std::clamp(inputs_.specular->evalAt(hit).r, 0.0f, 1.0f);
+  if (sheen_) {
+    p.sheenColor = glm::clamp(inputs_.sheenColor->evalAt(hit), Color(0.0f), Color(1.0f));
+    p.sheenRoughness = inputs_.sheenRoughness ? inputs_.sheenRoughness->evalAt(hit).r : 0.0f;
+  }
+  if (coat_) {
+    p.clearcoat = std::clamp(inputs_.clearcoat->evalAt(hit).r, 0.0f, 1.0f);
+    const float roughness = inputs_.clearcoatRoughness ? inputs_.clearcoatRoughness->evalAt(hit).r : 0.0f;
+    p.coatGgx = Ggx::fromRoughness(std::clamp(roughness, 0.0f, 1.0f));
+    // The coat's normal: the geometry's interpolated one, not the base's normal map (the
+    // extension: "if clearcoatNormalTexture is not given, no normal mapping is applied").
+    Vec3 n = hit.attributes ? hit.attributes->normalAt(hit.prim, hit.bary) : hit.ns;
+    if (inputs_.clearcoatNormal && hit.attributes)
+      n = SurfaceMaps::perturbNormal(*inputs_.clearcoatNormal, inputs_.clearcoatNormalScale, n,
+                                     hit.attributes->tangentAt(hit.prim, hit.bary),
+                                     hit.texCoord(inputs_.clearcoatNormal->texCoordSet()));
+    p.coatNormal = glm::dot(n, hit.ng) < 0.0f ? -n : n;
+  }
   return p;
 }
 
-GltfPbrMaterial::LobeProbabilities GltfPbrMaterial::lobeProbabilities(const Params& p, float cosO,
-                                                                      bool outside) const {
+bool GltfPbrMaterial::frames(const SurfaceHit& hit, const Vec3& wo, const Params& p, Frames& f) const {
+  f.outside = glm::dot(wo, hit.ng) >= 0.0f;
+  f.base = Frame(f.outside ? hit.ns : -hit.ns);  // facingNormal(hit, wo)
+  f.o = f.base.toLocal(wo);
+  if (!(f.o.z > 0.0f)) return false;  // wo under the shading hemisphere
+  f.layers = !refracts_ || f.outside;
+  if (coat_ && f.layers) {
+    f.coat = Frame(f.outside ? p.coatNormal : -p.coatNormal);
+    f.oc = f.coat.toLocal(wo);
+  } else {
+    f.oc = Vec3(0.0f);
+  }
+  return true;
+}
+
+float GltfPbrMaterial::coatWeight(const Params& p, const Frames& f) const {
+  if (!coat_ || !f.layers || !(f.oc.z > 0.0f)) return 0.0f;
+  return p.clearcoat * schlickFresnel(kCoatF0, f.oc.z);
+}
+
+GltfPbrMaterial::LobeProbabilities GltfPbrMaterial::lobeProbabilities(const Params& p, const Frames& f) const {
+  const float cosO = f.o.z;
   // The layer's Fresnel term at n.v, capped below 1 inside a volume: past the critical angle most
   // visible microfacets reflect totally, but those tilted towards wo still refract, so the
   // transmission lobe must keep some probability.
-  const float fd = std::min(dielectricFresnel(cosO, outside), 0.9f);
+  const float fd = std::min(p.specularWeight * maxOf(dielectricFresnel(p, cosO, f.outside)), 0.9f);
   const float fm = maxComponent(schlickFresnel(p.baseColor, cosO));
   const float dielectric = 1.0f - p.metallic;
-  const float base = dielectric * (1.0f - fd) * maxComponent(p.baseColor);
-  const float ws = dielectric * fd + p.metallic * fm;
+  const float coat = coatWeight(p, f);
+  const float sheen = sheen_ && f.layers ? maxOf(p.sheenColor) * sheenAlbedo(cosO, p.sheenRoughness) : 0.0f;
+  const float under = (1.0f - coat) * (1.0f - sheen);
+  const float base = under * dielectric * (1.0f - fd) * maxComponent(p.baseColor);
+  const float ws = under * (dielectric * fd + p.metallic * fm);
   const float wd = base * (1.0f - p.transmission);
   const float wt = base * p.transmission;
-  const float sum = ws + wd + wt;
-  if (!(sum > 0.0f)) return {1.0f, 0.0f, 0.0f};
-  return {ws / sum, wd / sum, wt / sum};
+  const float wsh = (1.0f - coat) * sheen;
+  const float sum = ws + wd + wt + wsh + coat;
+  if (!(sum > 0.0f)) return {1.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+  return {ws / sum, wd / sum, wt / sum, wsh / sum, coat / sum};
 }
 
-float GltfPbrMaterial::dielectricFresnel(float cosOH, bool outside) const {
-  if (!refracts_ || outside) return schlickFresnel(f0_, cosOH);
+Color GltfPbrMaterial::dielectricFresnel(const Params& p, float cosOH, bool outside) const {
+  if (!refracts_ || outside) return schlickFresnel(p.specularF0, cosOH);
   // Inside a volume (eta_t / eta_i = 1 / ior): Snell's sin_t = ior sin_i; past the critical angle
   // everything is reflected, otherwise Schlick at the outside cosine (see the top comment).
   const float sin2T = std::max(0.0f, 1.0f - cosOH * cosOH) * ior_ * ior_;
-  if (sin2T >= 1.0f) return 1.0f;
-  return schlickFresnel(f0_, std::sqrt(1.0f - sin2T));
+  if (sin2T >= 1.0f) return Color(1.0f);
+  return schlickFresnel(p.specularF0, std::sqrt(1.0f - sin2T));
 }
 
-Color GltfPbrMaterial::evalLocal(const Params& p, const LobeProbabilities& lobes, const Vec3& o,
-                                 const Vec3& i, bool reflection, bool outside, float& pdf) const {
+Color GltfPbrMaterial::evalBase(const Params& p, const LobeProbabilities& lobes, const Vec3& o,
+                                const Vec3& i, bool reflection, bool outside, float& pdf) const {
   pdf = 0.0f;
   const Ggx& g = p.ggx;
   const float dielectric = 1.0f - p.metallic;
@@ -108,12 +185,12 @@ Color GltfPbrMaterial::evalLocal(const Params& p, const LobeProbabilities& lobes
     const Vec3 h = glm::normalize(o + i);  // o.z, i.z > 0: the sum is never zero
     const float cosOH = glm::dot(o, h);
     const float specular = g.D(h) * g.V(o, i);  // specular_brdf = D V (glTF B.3.2)
-    const float fd = dielectricFresnel(cosOH, outside);
+    const Color fd = p.specularWeight * dielectricFresnel(p, cosOH, outside);
     const Color fm = schlickFresnel(p.baseColor, cosOH);
     // mix(fresnel_mix(base, specular), conductor_fresnel(specular), metallic), base = the diffuse
     // part only (the BTDF is zero for a reflection).
     const Color f =
-        dielectric * ((1.0f - fd) * (1.0f - p.transmission) * kInvPi * p.baseColor + Color(fd * specular)) +
+        dielectric * ((1.0f - maxOf(fd)) * (1.0f - p.transmission) * kInvPi * p.baseColor + fd * specular) +
         p.metallic * specular * fm;
     pdf = lobes.diffuse * cosineHemispherePdf(i.z) + lobes.specular * g.reflectionPdf(o, h);
     return f * i.z;
@@ -125,7 +202,7 @@ Color GltfPbrMaterial::evalLocal(const Params& p, const LobeProbabilities& lobes
     // Thin-walled: the reflection lobe of the mirrored direction (flip along the normal).
     const Vec3 m(i.x, i.y, -i.z);
     const Vec3 h = glm::normalize(o + m);
-    const float fd = schlickFresnel(f0_, glm::dot(o, h));
+    const float fd = p.specularWeight * maxOf(schlickFresnel(p.specularF0, glm::dot(o, h)));
     pdf = lobes.transmission * g.reflectionPdf(o, h);
     return (scale * (1.0f - fd) * g.D(h) * g.V(o, m) * m.z) * p.baseColor;
   }
@@ -144,7 +221,7 @@ Color GltfPbrMaterial::evalLocal(const Params& p, const LobeProbabilities& lobes
   // hand here, so the outside one is taken directly rather than through Snell's law, whose
   // cos_t = sqrt(1 - sin_t^2) loses precision near the critical angle: F is then exactly the same
   // for (wo, wi) and (wi, wo).
-  const float F = schlickFresnel(f0_, outside ? cosOH : -cosIH);
+  const float F = p.specularWeight * maxOf(schlickFresnel(p.specularF0, outside ? cosOH : -cosIH));
   // Radiance BTDF times |cos_i|: (1 - F) D G2 |i.h| |o.h| / (|o.z| (o.h + eta i.h)^2) (Walter eq. 21
   // divided by eta^2). G2 / |o.z| = 2 |i.z| / (|i.z| root(o) + |o.z| root(i)) stays finite as o.z -> 0.
   const float ai = -i.z;
@@ -155,15 +232,43 @@ Color GltfPbrMaterial::evalLocal(const Params& p, const LobeProbabilities& lobes
   return (scale * (1.0f - F) * g.D(h) * g2OverCosO * -cosIH * cosOH / len2) * p.baseColor;
 }
 
+Color GltfPbrMaterial::evalLayers(const Params& p, const LobeProbabilities& lobes, const Frames& f,
+                                  const SurfaceHit& hit, const Vec3& wo, const Vec3& wi, float& pdf) const {
+  const bool reflection = sameSide(hit, wo, wi);
+  const Vec3 i = f.base.toLocal(wi);
+  Color result = evalBase(p, lobes, f.o, i, reflection, f.outside, pdf);
+  if (!f.layers) return result;
+  if (sheen_) {
+    // Albedo scaling of the base (Estevez & Kulla 2017, section 4; the extension's
+    // sheenAlbedoScaling), then the sheen lobe itself for a reflection.
+    const float m = maxOf(p.sheenColor);
+    const float scaling = std::min(1.0f - m * sheenAlbedo(f.o.z, p.sheenRoughness),
+                                   1.0f - m * sheenAlbedo(i.z, p.sheenRoughness));
+    result *= scaling;
+    if (reflection && i.z > 0.0f) {
+      result += CharlieSheen(p.sheenRoughness).evalCos(f.o, i) * p.sheenColor;
+      pdf += lobes.sheen * (0.5f * kInvPi);
+    }
+  }
+  if (coat_) {
+    const float weight = coatWeight(p, f);
+    result *= 1.0f - weight;
+    const Vec3 ic = f.coat.toLocal(wi);
+    if (reflection && weight > 0.0f && ic.z > 0.0f) {
+      const Vec3 h = glm::normalize(f.oc + ic);
+      result += Color(weight * p.coatGgx.D(h) * p.coatGgx.V(f.oc, ic) * ic.z);
+      pdf += lobes.coat * p.coatGgx.reflectionPdf(f.oc, h);
+    }
+  }
+  return result;
+}
+
 Color GltfPbrMaterial::evalAndPdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi, float& pdf) const {
   pdf = 0.0f;
-  const bool outside = glm::dot(wo, hit.ng) >= 0.0f;
-  const Frame frame(outside ? hit.ns : -hit.ns);  // facingNormal(hit, wo)
-  const Vec3 o = frame.toLocal(wo);
-  if (!(o.z > 0.0f)) return Color(0.0f);  // wo under the shading hemisphere
   const Params& p = fetchFor(hit);
-  return evalLocal(p, lobeProbabilities(p, o.z, outside), o, frame.toLocal(wi), sameSide(hit, wo, wi),
-                   outside, pdf);
+  Frames f;
+  if (!frames(hit, wo, p, f)) return Color(0.0f);
+  return evalLayers(p, lobeProbabilities(p, f), f, hit, wo, wi, pdf);
 }
 
 Color GltfPbrMaterial::eval(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) const {
@@ -179,44 +284,60 @@ float GltfPbrMaterial::pdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi
 
 bool GltfPbrMaterial::sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float uLobe,
                              BsdfSample& out) const {
-  const bool outside = glm::dot(wo, hit.ng) >= 0.0f;
-  const Frame frame(outside ? hit.ns : -hit.ns);
-  const Vec3 o = frame.toLocal(wo);
-  if (!(o.z > 0.0f)) return false;
   const Params& p = fetchFor(hit);
-  const LobeProbabilities lobes = lobeProbabilities(p, o.z, outside);
+  Frames f;
+  if (!frames(hit, wo, p, f)) return false;
+  const LobeProbabilities lobes = lobeProbabilities(p, f);
+  const Vec3& o = f.o;
 
-  Vec3 i;
+  // The lobes in the order coat, sheen, specular, diffuse, transmission along uLobe; rounding that
+  // leaves uLobe past the last one of non-zero probability falls back to it.
+  Vec3 wi;
   bool transmit = false;
   float eta = 1.0f;
-  // Fall back to a lobe of non-zero probability should rounding leave uLobe past the last one.
-  const bool specular = uLobe < lobes.specular || (!(lobes.diffuse > 0.0f) && !(lobes.transmission > 0.0f));
-  const bool diffuse = !specular && (uLobe < lobes.specular + lobes.diffuse || !(lobes.transmission > 0.0f));
-  if (specular) {
-    i = reflect(o, p.ggx.sampleVisibleNormal(o, u));
-  } else if (diffuse) {
-    i = sampleCosineHemisphere(u);
+  float edge = lobes.coat;
+  if (uLobe < edge) {
+    wi = f.coat.toWorld(reflect(f.oc, p.coatGgx.sampleVisibleNormal(f.oc, u)));
+  } else if (uLobe < (edge += lobes.sheen)) {
+    const Vec3 d = sampleCosineHemisphere(u);
+    // Uniform in the hemisphere: the cosine-weighted direction's polar angle remapped,
+    // cos theta = 1 - (1 - cos theta_c^2) (an equal-area map: cos^2 is uniform, so is 1 - cos^2).
+    const float sin2 = d.x * d.x + d.y * d.y;
+    const float cosT = 1.0f - sin2;
+    const float scale = sin2 > 0.0f ? std::sqrt(std::max(0.0f, 1.0f - cosT * cosT) / sin2) : 0.0f;
+    wi = f.base.toWorld(Vec3(d.x * scale, d.y * scale, cosT));
   } else {
-    transmit = true;
-    const Vec3 h = p.ggx.sampleVisibleNormal(o, u);
-    if (refracts_) {
-      eta = outside ? ior_ : 1.0f / ior_;
-      if (!refract(o, h, eta, i)) return false;  // total internal reflection on this microfacet
+    const float rest = uLobe - edge;
+    const bool specular = rest < lobes.specular || (!(lobes.diffuse > 0.0f) && !(lobes.transmission > 0.0f));
+    const bool diffuse = !specular && (rest < lobes.specular + lobes.diffuse || !(lobes.transmission > 0.0f));
+    Vec3 i;
+    if (specular) {
+      i = reflect(o, p.ggx.sampleVisibleNormal(o, u));
+    } else if (diffuse) {
+      i = sampleCosineHemisphere(u);
     } else {
-      i = reflect(o, h);
-      i.z = -i.z;
+      transmit = true;
+      const Vec3 h = p.ggx.sampleVisibleNormal(o, u);
+      if (refracts_) {
+        eta = f.outside ? ior_ : 1.0f / ior_;
+        if (!refract(o, h, eta, i)) return false;  // total internal reflection on this microfacet
+      } else {
+        i = reflect(o, h);
+        i.z = -i.z;
+      }
     }
+    // A direction outside its lobe's hemisphere is absorbed (see the top comment).
+    if (transmit ? !(i.z < 0.0f) : !(i.z > 0.0f)) return false;
+    wi = f.base.toWorld(i);
   }
-  // A direction outside its lobe's hemisphere is absorbed (see the top comment).
-  if (transmit ? !(i.z < 0.0f) : !(i.z > 0.0f)) return false;
-  out.wi = glm::normalize(frame.toWorld(i));
+  out.wi = glm::normalize(wi);
   const bool reflection = sameSide(hit, wo, out.wi);
   if (reflection == transmit) return false;  // crossed the geometric surface the wrong way
 
   // The same evaluation as eval() and pdf() on the returned direction, so the three agree exactly.
-  const Color f = evalLocal(p, lobes, o, frame.toLocal(out.wi), reflection, outside, out.pdf);
+  const Color fval = evalLayers(p, lobes, f, hit, wo, out.wi, out.pdf);
   if (!(out.pdf > 0.0f)) return false;
-  out.weight = f / out.pdf;
+  out.weight = fval / out.pdf;
   out.delta = false;
   out.eta = transmit ? eta : 1.0f;
   return true;

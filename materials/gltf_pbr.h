@@ -1,18 +1,28 @@
 // The glTF 2.0 metallic-roughness material exactly as the specification's Appendix B defines it,
-// extended by KHR_materials_transmission and KHR_materials_ior (and the thin-walled / volumetric
-// distinction of KHR_materials_volume):
+// with the Khronos material extensions layered on it as their texts define them:
 //
 //   specular_brdf  = D(h) V(l, v)                      Trowbridge-Reitz (GGX) D, alpha = roughness^2,
 //                                                      height-correlated Smith V (Heitz 2014, eq. 99)
 //   metal_brdf     = specular_brdf * schlick(f0 = baseColor)
-//   dielectric     = mix(base, specular_brdf, schlick(f0 = ((ior - 1) / (ior + 1))^2))
+//   dielectric     = (1 - w max3(Fr)) base + w Fr specular_brdf     (KHR_materials_specular):
+//                    Fr = schlick(f0 = min(((ior - 1) / (ior + 1))^2 specularColor, 1)), w = specular
 //   base           = mix(diffuse_brdf(baseColor), specular_btdf(alpha) * baseColor, transmission)
 //   material       = mix(dielectric, metal_brdf, metallic)
+//   sheen layer    = sheenColor f_charlie + material * min(1 - max3(sheenColor) E(n.v),
+//                                                          1 - max3(sheenColor) E(n.l))
+//                    (KHR_materials_sheen; materials/sheen.h)
+//   coated         = mix(sheen layer, clearcoat_brdf, clearcoat * schlick(0.04, n_c.v))
+//                    (KHR_materials_clearcoat: a GGX lobe of its own roughness about its own normal
+//                    n_c, the geometry's normal or its own normal map)
 //
-// Textures are looked up at hit.uv; hit.ns is the (possibly normal-mapped) shading normal.
-// Two-sided for reflection, like Lambertian. Sampled with a mixture of cosine-weighted diffuse and
-// GGX visible-normal sampling (Heitz 2018), the mixture pdf being reported, so every strategy is
-// MIS-compatible.
+// with KHR_materials_transmission, _ior and _volume (thin-walled or refracting). Without the
+// extensions (w = 1, specularColor = 1, no sheen, no coat) it is Appendix B term for term.
+//
+// Textures are looked up at the hit (each in its own texture coordinate set, the base colour times
+// COLOR_0); hit.ns is the (possibly normal-mapped) shading normal. Two-sided for reflection, like
+// Lambertian. Sampled with a one-sample mixture of cosine-weighted diffuse, GGX visible-normal
+// sampling (Heitz 2018) of the base and of the coat, and uniform hemisphere sampling of the sheen,
+// the mixture pdf being reported, so every strategy is MIS-compatible.
 #pragma once
 
 #include "materials/material.h"
@@ -28,7 +38,16 @@ struct GltfPbrInputs {
   std::shared_ptr<const Texture> baseColor;          // linear RGB, baseColorFactor included
   std::shared_ptr<const Texture> metallicRoughness;  // .g = roughness, .b = metallic, factors included
   std::shared_ptr<const Texture> transmission;       // .r = transmission, factor included; null = 0
-  float ior = 1.5f;
+  // KHR_materials_specular: .r = specularFactor x specularTexture.a, null = 1; the colour factor x
+  // specularColorTexture (linear RGB, may exceed 1), null = white.
+  std::shared_ptr<const Texture> specular, specularColor;
+  // KHR_materials_sheen: the colour (linear RGB, null = no sheen layer) and .r = the roughness.
+  std::shared_ptr<const Texture> sheenColor, sheenRoughness;
+  // KHR_materials_clearcoat: .r = the coat's weight (null = no coat), .r = its roughness, and its
+  // own tangent-space normal map (null: the geometry's interpolated normal, unmapped).
+  std::shared_ptr<const Texture> clearcoat, clearcoatRoughness, clearcoatNormal;
+  float clearcoatNormalScale = 1.0f;
+  float ior = 1.5f;  // 0: the dielectric reflects totally (f0 = 1), as KHR_materials_ior allows
   // KHR_materials_transmission without KHR_materials_volume is thin-walled: light passes through
   // the surface without bending. With a volume (thicknessFactor > 0) the surface is a refracting
   // interface whose inside lies opposite the outward geometric normal.
@@ -66,29 +85,52 @@ class GltfPbrMaterial final : public Material {
     Color baseColor{0.0f};
     float metallic = 0.0f, transmission = 0.0f;
     Ggx ggx = Ggx::fromRoughness(1.0f);
+    Color specularF0{0.04f};  // the dielectric's colour at normal incidence, before the weight
+    float specularWeight = 1.0f;
+    Color sheenColor{0.0f};
+    float sheenRoughness = 0.0f;
+    float clearcoat = 0.0f;
+    Ggx coatGgx = Ggx::fromRoughness(0.0f);
+    Vec3 coatNormal{0.0f};  // world space, on the side of hit.ng
   };
   // Probabilities with which sample() picks its lobes (they sum to 1).
   struct LobeProbabilities {
-    float specular, diffuse, transmission;
+    float specular, diffuse, transmission, sheen = 0.0f, coat = 0.0f;
+  };
+  // The local frames of one vertex: the base's (the shading normal turned to wo) and the coat's.
+  struct Frames {
+    Frame base, coat;
+    Vec3 o, oc;    // wo in each
+    bool outside;  // wo on the side of hit.ng
+    bool layers;   // the sheen and coat apply: not inside a refracting volume
   };
 
-  Params fetch(Vec2 uv) const;
+  Params fetch(const SurfaceHit& hit) const;
   // fetch(hit.uv), remembered for the hit (materials/hit_memo.h): a vertex asks twice, for the
   // light sample's evalPdf and for sample. The reference stays valid until the thread's next
   // fetchFor.
   const Params& fetchFor(const SurfaceHit& hit) const;
-  LobeProbabilities lobeProbabilities(const Params& p, float cosO, bool outside) const;
-  // Fresnel reflectance of the dielectric layer for the cosine between wo and the microfacet normal.
-  float dielectricFresnel(float cosOH, bool outside) const;
-  // f |cos theta_i| and the mixture pdf of sample() together, in the local frame of the normal that
-  // faces wo (o.z > 0); `reflection`: wi lies on wo's side of the geometric surface.
-  Color evalLocal(const Params& p, const LobeProbabilities& lobes, const Vec3& o, const Vec3& i,
-                  bool reflection, bool outside, float& pdf) const;
+  bool frames(const SurfaceHit& hit, const Vec3& wo, const Params& p, Frames& out) const;
+  LobeProbabilities lobeProbabilities(const Params& p, const Frames& f) const;
+  // Fresnel reflectance of the dielectric layer for the cosine between wo and the microfacet
+  // normal, before the specular weight.
+  Color dielectricFresnel(const Params& p, float cosOH, bool outside) const;
+  // The clearcoat's Fresnel weight, clearcoat x schlick(0.04, n_c.v).
+  float coatWeight(const Params& p, const Frames& f) const;
+  // f |cos theta_i| of the base (Appendix B with specular and transmission) and the mixture pdf of
+  // its lobes, in the base frame (o.z > 0); `reflection`: wi lies on wo's side of the geometric
+  // surface.
+  Color evalBase(const Params& p, const LobeProbabilities& lobes, const Vec3& o, const Vec3& i,
+                 bool reflection, bool outside, float& pdf) const;
+  // The whole layered BSDF, f |cos theta_i|, and sample()'s mixture pdf for world direction wi.
+  Color evalLayers(const Params& p, const LobeProbabilities& lobes, const Frames& f, const SurfaceHit& hit,
+                   const Vec3& wo, const Vec3& wi, float& pdf) const;
   Color evalAndPdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi, float& pdf) const;
 
   GltfPbrInputs inputs_;
   float ior_;      // max(ior, 1)
   float f0_;       // ((ior - 1) / (ior + 1))^2, the dielectric's normal-incidence reflectance
+  bool sheen_, coat_;  // the layers are present
   bool refracts_;  // a volumetric (bending) transmission lobe: !thinWalled and ior_ > 1
   uint64_t id_;    // fetchFor's memo key: newHitMemoOwner()
 };

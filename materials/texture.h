@@ -29,6 +29,9 @@ class Texture {
   virtual bool isConstant() const { return false; }
   // Whether eval can return black (every channel zero) at some uv; false only where it cannot.
   virtual bool mayBeBlack() const { return true; }
+  // The set of texture coordinates eval expects (glTF textureInfo.texCoord): callers without a
+  // hit (a light sample, Embree's alpha filter) interpolate that set themselves.
+  virtual int texCoordSet() const { return 0; }
 };
 
 class ConstantTexture final : public Texture {
@@ -115,6 +118,40 @@ class UvTransformTexture final : public Texture {
  private:
   std::shared_ptr<const Texture> inner_;
   Vec2 offset_, row0_, row1_;
+};
+
+// A texture read with texture coordinate set `set` (glTF's TEXCOORD_n, n > 0): evalAt looks the
+// hit's coordinates of that set up; eval takes coordinates of that set already.
+class TexCoordSetTexture final : public Texture {
+ public:
+  TexCoordSetTexture(std::shared_ptr<const Texture> inner, int set) : inner_(std::move(inner)), set_(set) {}
+  Color eval(Vec2 uv) const override { return inner_->eval(uv); }
+  Color evalAt(const SurfaceHit& hit) const override { return inner_->eval(hit.texCoord(set_)); }
+  Color maxValue() const override { return inner_->maxValue(); }
+  Color average() const override { return inner_->average(); }
+  bool isConstant() const override { return inner_->isConstant(); }
+  bool mayBeBlack() const override { return inner_->mayBeBlack(); }
+  int texCoordSet() const override { return set_; }
+
+ private:
+  std::shared_ptr<const Texture> inner_;
+  int set_;
+};
+
+// A colour texture times the hit's vertex colour (glTF COLOR_0 on the base colour, section
+// 3.9.2). Vertex colours lie in [0, 1], so the inner texture's bounds hold for the product.
+class VertexColorTexture final : public Texture {
+ public:
+  explicit VertexColorTexture(std::shared_ptr<const Texture> inner) : inner_(std::move(inner)) {}
+  Color eval(Vec2 uv) const override { return inner_->eval(uv); }
+  Color evalAt(const SurfaceHit& hit) const override { return inner_->evalAt(hit) * Color(hit.vertexColor()); }
+  Color maxValue() const override { return inner_->maxValue(); }
+  Color average() const override { return inner_->average(); }
+  bool mayBeBlack() const override { return true; }
+  int texCoordSet() const override { return inner_->texCoordSet(); }
+
+ private:
+  std::shared_ptr<const Texture> inner_;
 };
 
 // The exact piecewise sRGB EOTF (IEC 61966-2-1) for one channel value in [0, 1].

@@ -165,10 +165,9 @@ bool TriangleLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
   out.delta = false;
   out.Li = twoSided_ || glm::dot(-out.wi, ng_) > 0.0f ? radiance_ : Color(0.0f);
   if (texture_ || mesh_->opacity) {
-    const Vec2 uv = mesh_->uvAt(prim_, b.x, b.y);
-    if (texture_) out.Li *= texture_->eval(uv);
+    if (texture_) out.Li *= texture_->eval(mesh_->texCoordAt(texture_->texCoordSet(), prim_, b));
     // Cut-out (MASK) or partly transparent (BLEND) parts emit as much as rays that hit them find.
-    if (mesh_->opacity) out.Li *= mesh_->opacity->coverage(uv);
+    if (mesh_->opacity) out.Li *= mesh_->opacity->coverage(*mesh_, prim_, b);
   }
   return out.pdf > 0.0f && std::isfinite(out.pdf);
 }

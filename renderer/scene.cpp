@@ -183,14 +183,19 @@ void Scene::surfaceHit(const Ray& ray, const RawHit& raw, SurfaceHit& hit) const
       hit.pError = roundingErrorBound(magnitude + raw.t);
     }
     hit.ns = raw.ng;  // every analytic shape is shaded with its geometric normal
+    hit.attributes = nullptr;
   } else {
     hit.p = rec.mesh->pointAt(raw.primID, raw.uv.x, raw.uv.y);
     hit.pError = rec.mesh->pointError(raw.primID);
     const TriangleMesh::Surface s = rec.mesh->surfaceAt(raw.primID, raw.uv.x, raw.uv.y);
     hit.ng = s.ng;
     hit.uv = s.uv;
+    hit.attributes = rec.mesh;
+    hit.prim = raw.primID;
+    hit.bary = raw.uv;
     Vec3 ns = s.ns;
-    if (rec.maps && rec.maps->normalMap) ns = rec.maps->perturb(s.ns, s.tangent, s.uv);
+    if (rec.maps && rec.maps->normalMap)
+      ns = rec.maps->perturb(s.ns, s.tangent, hit.texCoord(rec.maps->normalMap->texCoordSet()));
     // Keep the shading normal in the geometric normal's hemisphere.
     hit.ns = glm::dot(ns, s.ng) < 0.0f ? -ns : ns;
   }
@@ -202,7 +207,7 @@ void Scene::surfaceHit(const Ray& ray, const RawHit& raw, SurfaceHit& hit) const
   hit.maskFront = rec.maskFront;
   hit.maskBack = rec.maskBack;
   if (rec.maps && rec.maps->emission && !isBlack(rec.emission))
-    hit.emission *= rec.maps->emission->eval(hit.uv);
+    hit.emission *= rec.maps->emission->evalAt(hit);
 }
 
 void Scene::prefetchTriangle(uint32_t geomID, uint32_t primID) const {
