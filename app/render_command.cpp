@@ -40,6 +40,7 @@ struct RenderArgs {
   std::string kernel = "lanes";
   std::string packetWidth = "auto";
   std::string env;
+  std::optional<float> envStrength;
   bool quiet = false;
   std::string checkpoint, resume, time;
   double checkpointEvery = 60.0;
@@ -63,8 +64,34 @@ std::string isoTime() {
   return buf;
 }
 
-// --env: "r,g,b" or one number is a constant environment, anything else an equirectangular map.
-void applyEnvironment(const std::string& value, Scene& scene) {
+// --env-strength travels inside the --env value, so that a checkpoint's identity (which keeps the
+// value) restores both: "SPEC\nstrength=S". No file name holds a line break.
+constexpr const char* kStrengthTag = "\nstrength=";
+
+// --env: none, white, "r,g,b" or one number for a constant environment, anything else an
+// equirectangular map; times --env-strength. Says on stderr what was taken.
+void applyEnvironment(const std::string& spec, Scene& scene) {
+  std::string value = spec;
+  float strength = 1.0f;
+  if (const size_t tag = spec.find(kStrengthTag); tag != std::string::npos) {
+    value = spec.substr(0, tag);
+    strength = std::strtof(spec.c_str() + tag + std::strlen(kStrengthTag), nullptr);
+  }
+  const auto say = [&](const std::string& what) {
+    std::fprintf(stderr, "ember: environment: %s (--env)\n", what.c_str());
+  };
+  const auto number = [](float v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", double(v));
+    return std::string(text);
+  };
+  const std::string times = strength == 1.0f ? "" : " x " + number(strength);
+  if (value == "none" || value == "white") {
+    scene.background = Color(value == "white" ? strength : 0.0f);
+    scene.environmentMap = nullptr;
+    say(value == "none" ? "none, black" : "white, radiance " + number(strength));
+    return;
+  }
   std::vector<float> numbers;
   std::stringstream in(value);
   std::string part;
@@ -76,13 +103,17 @@ void applyEnvironment(const std::string& value, Scene& scene) {
     numbers.push_back(v);
   }
   if (numeric && (numbers.size() == 1 || numbers.size() == 3)) {
-    scene.background = numbers.size() == 1 ? Color(numbers[0]) : Color(numbers[0], numbers[1], numbers[2]);
+    scene.background =
+        strength * (numbers.size() == 1 ? Color(numbers[0]) : Color(numbers[0], numbers[1], numbers[2]));
     scene.environmentMap = nullptr;
+    say("constant radiance " + value + times);
     return;
   }
-  if (numeric) throw InputError("--env " + value + ": expected r,g,b or one number >= 0, or an image file");
-  scene.environmentMap = loadEnvironmentMap(value);
+  if (numeric)
+    throw InputError("--env " + value + ": expected none, white, r,g,b or one number >= 0, or an image file");
+  scene.environmentMap = loadEnvironmentMap(value, Color(strength));
   scene.background = Color(0.0f);
+  say("map " + value + times);
 }
 
 // "90", "90s", "10m", "2h" -> seconds.
@@ -135,6 +166,7 @@ RenderSetup setUp(RenderArgs& a) {
                                                    {!a.strategy.empty(), "--strategy"},
                                                    {!a.caustics.empty(), "--caustics"},
                                                    {!a.env.empty(), "--env"},
+                                                   {a.envStrength.has_value(), "--env-strength"},
                                                    {a.camera >= 0, "--camera"},
                                                    {a.firstSample != 0, "--first-sample"},
                                                    {a.passSpp.has_value(), "--pass-spp"}})
@@ -183,6 +215,10 @@ RenderSetup setUp(RenderArgs& a) {
   }
   if (a.scene.empty()) throw InputError("a scene file is required (or --resume FILE)");
   if (a.output.empty()) throw InputError("-o/--output is required");
+  if (a.envStrength) {
+    if (a.env.empty()) throw InputError("--env-strength scales the --env light; give --env too (e.g. --env white)");
+    a.env += kStrengthTag + std::to_string(*a.envStrength);
+  }
   setup.scene = loadConfigured(a.scene, a.camera, a.env);
   RenderSettings& s = setup.scene.settings;
   if (a.spp) s.spp = *a.spp;
@@ -385,8 +421,10 @@ Runner addRenderCommand(CLI::App& app) {
          "traverses 16-ray packets natively, as with AVX-512, else 8), 8 or 16; the image is the same")
       ->check(CLI::IsMember({"auto", "8", "16"}));
   cmd->add_option("--env", args->env,
-                  "Environment light: r,g,b (or one number) for a constant colour, or an equirectangular "
-                  "EXR/HDR map; replaces the scene's");
+                  "Environment light: none, white, r,g,b (or one number) for a constant colour, or an "
+                  "equirectangular EXR/HDR map; replaces the scene's or the default one");
+  cmd->add_option("--env-strength", args->envStrength, "Multiplies the --env light (default 1)")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--camera", args->camera,
                   "glTF files: render through camera N of the file's `cameras` (default: the first one a "
                   "node places, else a camera framing the scene)")

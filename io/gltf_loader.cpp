@@ -134,7 +134,7 @@ class GltfImporter {
         "KHR_materials_transmission", "KHR_materials_ior",
         "KHR_materials_volume",       "KHR_texture_transform",
         "KHR_materials_specular",     "KHR_materials_sheen",
-        "KHR_materials_clearcoat",
+        "KHR_materials_clearcoat",    "KHR_materials_unlit",
         "KHR_mesh_quantization"};
     return supported;
   }

@@ -2,6 +2,7 @@
 
 #include "io/input_error.h"
 #include "materials/gltf_pbr.h"
+#include "materials/lambertian.h"
 
 #include <cstdio>
 #include <cstring>
@@ -246,6 +247,19 @@ GltfSurface GltfMaterialReader::convert(int index, bool vertexColors) {
                               Channels::LinearRgb, Color(1.0f), where + ".normalTexture");
     maps->normalScale = float(m.normalTexture.scale);
     if (!std::isfinite(maps->normalScale)) fail(where + ".normalTexture.scale", "expected a number");
+  }
+  // KHR_materials_unlit: the surface shows its base colour (times COLOR_0) whatever the lighting,
+  // which a path tracer renders as a black surface emitting that colour: seen directly and in
+  // reflections, as viewers show it, and lighting what faces it by that much.
+  if (extension(m.extensions, "KHR_materials_unlit")) {
+    out.material = scene_.addMaterial(name + " (unlit)", std::make_unique<Lambertian>(
+                                                             std::make_shared<ConstantTexture>(Color(0.0f))));
+    out.emission = baseRgb;
+    maps->normalMap = nullptr;
+    maps->emission = texture(pbr.baseColorTexture, Channels::SrgbRgb, Color(1.0f), where + ".baseColorTexture");
+    if (vertexColors)
+      maps->emission = std::make_shared<VertexColorTexture>(
+          maps->emission ? maps->emission : std::make_shared<ConstantTexture>(Color(1.0f)));
   }
   if (maps->emission || maps->normalMap) out.maps = std::move(maps);
 

@@ -499,18 +499,27 @@ Scene loadGltfScene(const std::string& path, const LoadOptions& load) {
     scene.settings.width = 512;
     scene.cameraParams = framingCamera(bounds, 512.0f / 384.0f);
   }
-  // A file with no light of any kind (no KHR_lights_punctual light, no emissive material) gets a
-  // uniform white environment, like an overcast sky; one with lights is lit by them alone, as
-  // Blender renders it (`--env` adds an environment).
+  // A file lit by its own lights (KHR_lights_punctual, or emission brighter than 1, which only
+  // KHR_materials_emissive_strength gives and which is how Blender exports light-giving emission)
+  // is lit by them alone, as Blender renders it. Every other file, glowing screens and LEDs whose
+  // emissive factor is at most 1 included, gets a uniform white environment, as glTF viewers
+  // light a model. `--env` overrides either choice.
+  const auto lightGiving = [](const Color& emission) { return maxComponent(emission) > 1.0f; };
   const bool emissive = std::any_of(scene.meshes.begin(), scene.meshes.end(),
-                                    [](const auto& m) { return !isBlack(m.emission); }) ||
+                                    [&](const auto& m) { return lightGiving(m.emission); }) ||
                         std::any_of(scene.shapes.begin(), scene.shapes.end(),
-                                    [](const auto& s) { return !isBlack(s.emission); });
-  if (imported.lights == 0 && !emissive && !load.environmentGiven) {
-    scene.background = Color(1.0f);
-    std::fprintf(
-        stderr, "ember: %s has no lights; lighting it with a uniform white environment (--env replaces it)\n",
-        path.c_str());
+                                    [&](const auto& s) { return lightGiving(s.emission); });
+  if (!load.environmentGiven) {
+    if (imported.lights == 0 && !emissive) {
+      scene.background = Color(1.0f);
+      std::fprintf(stderr,
+                   "ember: environment: white, radiance 1 (%s has no light-giving emission or KHR light; "
+                   "--env none|white|r,g,b|FILE overrides)\n",
+                   path.c_str());
+    } else {
+      std::fprintf(stderr, "ember: environment: none (%s is lit by its own %s; --env adds one)\n", path.c_str(),
+                   imported.lights ? "KHR lights" : "emission");
+    }
   }
   return scene;
 }

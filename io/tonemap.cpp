@@ -13,8 +13,10 @@ Image reinhardLinear(const Image& image, const ReinhardParams& params, float* lo
   for (int y = 0; y < image.height; ++y)
     for (int x = 0; x < image.width; ++x) {
       const Color c = image.at(x, y);
-      if (!isFinite(c)) continue;
-      const float lum = std::max(0.0f, luminance(c));
+      const float lum = luminance(c);
+      // Black pixels (an empty background) stay out of the key's average: on a model against black
+      // they would pull the log-average towards delta and blow the model out to white.
+      if (!isFinite(c) || !(lum > 0.0f)) continue;
       logSum += std::log(kDelta + lum);
       maxLum = std::max(maxLum, lum);
       ++n;

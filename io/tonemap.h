@@ -1,5 +1,6 @@
 // Reinhard et al. 2002, "Photographic Tone Reproduction for Digital Images", global operator:
-//   log-average luminance   Lavg = exp(mean(log(delta + Lw)))                 (eq. 1)
+//   log-average luminance   Lavg = exp(mean(log(delta + Lw)))                 (eq. 1), over the
+//                           pixels that are not black (an empty background would set the key)
 //   scaled luminance        L = key / Lavg * Lw                                (eq. 2)
 //   display luminance       Ld = L (1 + L / Lwhite^2) / (1 + L)                (eq. 4)
 // Lwhite is given in input (scene) luminance and scaled like L; by default it is the image's

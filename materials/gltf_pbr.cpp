@@ -155,7 +155,7 @@ GltfPbrMaterial::LobeProbabilities GltfPbrMaterial::lobeProbabilities(const Para
   const float dielectric = 1.0f - p.metallic;
   const float coat = coatWeight(p, f);
   const float sheen = sheen_ && f.layers ? maxOf(p.sheenColor) * sheenAlbedo(cosO, p.sheenRoughness) : 0.0f;
-  const float under = (1.0f - coat) * (1.0f - sheen);
+  const float under = (1.0f - coat) * std::max(0.0f, 1.0f - sheen);
   const float base = under * dielectric * (1.0f - fd) * maxComponent(p.baseColor);
   const float ws = under * (dielectric * fd + p.metallic * fm);
   const float wd = base * (1.0f - p.transmission);
@@ -242,8 +242,9 @@ Color GltfPbrMaterial::evalLayers(const Params& p, const LobeProbabilities& lobe
     // Albedo scaling of the base (Estevez & Kulla 2017, section 4; the extension's
     // sheenAlbedoScaling), then the sheen lobe itself for a reflection.
     const float m = maxOf(p.sheenColor);
-    const float scaling = std::min(1.0f - m * sheenAlbedo(f.o.z, p.sheenRoughness),
-                                   1.0f - m * sheenAlbedo(i.z, p.sheenRoughness));
+    // Clamped at 0: towards grazing angles E exceeds 1 (materials/sheen.h).
+    const float scaling = std::max(0.0f, std::min(1.0f - m * sheenAlbedo(f.o.z, p.sheenRoughness),
+                                                  1.0f - m * sheenAlbedo(i.z, p.sheenRoughness)));
     result *= scaling;
     if (reflection && i.z > 0.0f) {
       result += CharlieSheen(p.sheenRoughness).evalCos(f.o, i) * p.sheenColor;

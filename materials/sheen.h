@@ -64,11 +64,14 @@ struct CharlieSheen {
 };
 
 // E(|cos theta|, roughness): the directional albedo of the white Charlie lobe, bilinear in a
-// table over cos theta in [0, 1] and roughness in [kMinRoughness, 1] computed once per process.
+// table over sqrt(cos theta) in [0, 1] and roughness in [kMinRoughness, 1] computed once per
+// process (about 0.1 s). Towards grazing angles E exceeds 1 (2.0 at cos theta = 0.02 and roughness
+// 0.07): the fitted shadowing of the definition does not bound it there.
 float sheenAlbedo(float cosTheta, float sheenRoughness);
 
-// The same integral by direct quadrature (n x n points over the hemisphere): what the table is
-// built from, and what tests check it against at finer n.
+// The same integral by direct quadrature (n x 2n points over the hemisphere, dense towards the
+// horizon): what the table is built from, and what tests check it against at finer n.
 double sheenAlbedoQuadrature(float cosTheta, float sheenRoughness, int n);
+
 
 }  // namespace ember

@@ -165,7 +165,15 @@ bool TriangleLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
   out.delta = false;
   out.Li = twoSided_ || glm::dot(-out.wi, ng_) > 0.0f ? radiance_ : Color(0.0f);
   if (texture_ || mesh_->opacity) {
-    if (texture_) out.Li *= texture_->eval(mesh_->texCoordAt(texture_->texCoordSet(), prim_, b));
+    if (texture_) {
+      // The texture as a hit there sees it: its own coordinate set, and COLOR_0 where it reads it.
+      SurfaceHit at;
+      at.uv = mesh_->uvAt(prim_, b.x, b.y);
+      at.attributes = mesh_;
+      at.prim = prim_;
+      at.bary = b;
+      out.Li *= texture_->evalAt(at);
+    }
     // Cut-out (MASK) or partly transparent (BLEND) parts emit as much as rays that hit them find.
     if (mesh_->opacity) out.Li *= mesh_->opacity->coverage(*mesh_, prim_, b);
   }

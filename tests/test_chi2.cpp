@@ -96,7 +96,7 @@ namespace {
 // Parameters of the test as a whole.
 
 constexpr double kAlpha = 0.01;     // family-wise significance level over every case in the file
-constexpr int kNumCases = 68;       // m for the Sidak correction: must equal allCases().size()
+constexpr int kNumCases = 76;       // m for the Sidak correction: must equal allCases().size()
 constexpr long kSamples = 1000000;  // samples per case
 constexpr double kMinExpected = 5.0;
 // Absolute error allowed on integrals of the pdf over the sphere: the midpoint rule on the
@@ -916,6 +916,63 @@ const std::vector<Chi2Case>& allCases() {
     for (const PbrCase& pc : pbrCases) {
       add(pc.name, [=](uint64_t s) {
         runMaterial(pbr(pc.roughness, pc.metallic, pc.transmission, pc.thinWalled), pc.wo, s);
+      });
+    }
+
+    // The Khronos layers (KHR_materials_specular, _sheen, _clearcoat) over the base: each lobe
+    // alone over a dark base, then all of them together, thin-walled and inside a volume (where the
+    // layers of the outer surface do not apply).
+    struct Layers {
+      Color specularColor{1.0f};
+      float specular = 1.0f;
+      Color sheen{0.0f};
+      float sheenRoughness = 0.5f, coat = 0.0f, coatRoughness = 0.1f;
+    };
+    auto layered = [](float roughness, float metallic, float transmission, bool thinWalled, Layers l) {
+      GltfPbrInputs in;
+      in.baseColor = constant(Color(0.3f, 0.2f, 0.1f));
+      in.metallicRoughness = constant(Color(0.0f, roughness, metallic));
+      if (transmission > 0.0f) in.transmission = constant(Color(transmission, 0.0f, 0.0f));
+      in.thinWalled = thinWalled;
+      in.specular = constant(Color(l.specular));
+      in.specularColor = constant(l.specularColor);
+      if (!isBlack(l.sheen)) {
+        in.sheenColor = constant(l.sheen);
+        in.sheenRoughness = constant(Color(l.sheenRoughness));
+      }
+      if (l.coat > 0.0f) {
+        in.clearcoat = constant(Color(l.coat));
+        in.clearcoatRoughness = constant(Color(l.coatRoughness));
+      }
+      return std::make_shared<GltfPbrMaterial>(std::move(in));
+    };
+    struct LayeredCase {
+      const char* name;
+      float roughness, metallic, transmission;
+      bool thinWalled;
+      Layers layers;
+      Vec3 wo;
+    };
+    const LayeredCase layeredCases[] = {
+        {"GltfSpecular_colour2_w0p6_r0p3_woOblique", 0.3f, 0.0f, 0.0f, true, {Color(2.0f, 1.0f, 0.5f), 0.6f},
+         woOblique},
+        {"GltfSheen_r0p5_woNormal", 0.6f, 0.0f, 0.0f, true, {Color(1.0f), 1.0f, Color(0.9f, 0.5f, 0.3f), 0.5f},
+         woNormal},
+        {"GltfSheen_r0p2_woGrazing", 0.6f, 0.0f, 0.0f, true, {Color(1.0f), 1.0f, Color(1.0f), 0.2f}, woGrazing},
+        {"GltfCoat_c1_r0p05_over_r0p6_woOblique", 0.6f, 0.0f, 0.0f, true,
+         {Color(1.0f), 1.0f, Color(0.0f), 0.5f, 1.0f, 0.05f}, woOblique},
+        {"GltfCoat_c0p5_r0p4_over_metal_woGrazing", 0.3f, 1.0f, 0.0f, true,
+         {Color(1.0f), 1.0f, Color(0.0f), 0.5f, 0.5f, 0.4f}, woGrazing},
+        {"GltfLayers_all_thin_t0p5_woBelow", 0.4f, 0.2f, 0.5f, true,
+         {Color(1.5f, 1.0f, 1.0f), 0.8f, Color(0.5f), 0.4f, 0.7f, 0.2f}, woBelow},
+        {"GltfLayers_all_volume_t0p7_woOblique", 0.3f, 0.0f, 0.7f, false,
+         {Color(1.0f), 0.9f, Color(0.6f), 0.6f, 0.8f, 0.1f}, woOblique},
+        {"GltfLayers_all_volume_t0p7_woBelowInside", 0.3f, 0.0f, 0.7f, false,
+         {Color(1.0f), 0.9f, Color(0.6f), 0.6f, 0.8f, 0.1f}, woBelow},
+    };
+    for (const LayeredCase& lc : layeredCases) {
+      add(lc.name, [=](uint64_t s) {
+        runMaterial(layered(lc.roughness, lc.metallic, lc.transmission, lc.thinWalled, lc.layers), lc.wo, s);
       });
     }
 

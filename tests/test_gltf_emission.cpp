@@ -17,14 +17,14 @@ using test::TempDir;
 // One emissive quad (z = 0, facing +z, strength 10 as Blender exports it) and, optionally, a grey
 // quad beside it that does not emit.
 std::string writeEmissiveQuad(const TempDir& dir, const std::string& name, bool doubleSided,
-                              bool emissive = true) {
+                              bool emissive = true, double emissiveStrength = 10.0) {
   test::GltfBuilder b;
   tinygltf::Material m;
   m.name = "glow";
   m.doubleSided = doubleSided;
   if (emissive) {
     m.emissiveFactor = {1.0, 1.0, 1.0};
-    tinygltf::Value::Object strength{{"emissiveStrength", tinygltf::Value(10.0)}};
+    tinygltf::Value::Object strength{{"emissiveStrength", tinygltf::Value(emissiveStrength)}};
     m.extensions["KHR_materials_emissive_strength"] = tinygltf::Value(strength);
     b.model().extensionsUsed.push_back("KHR_materials_emissive_strength");
   }
@@ -73,28 +73,40 @@ TEST(GltfEmission, DoubleSidedEmitsOnBothFacesSingleSidedOnTheFront) {
   }
 }
 
-TEST(GltfEmission, DefaultSkyOnlyForFilesWithNoLightAtAll) {
+// Light-giving emission (above 1: KHR_materials_emissive_strength > 1, as Blender exports it)
+// lights a file alone; a file without it, a glowing screen of emissive factor 1 included, gets the
+// white environment of glTF viewers. stderr says which, and --env overrides either way.
+TEST(GltfEmission, DefaultSkyUnlessTheFileHasLightGivingEmission) {
   const TempDir dir;
-  {
-    Scene lit = loadScene(writeEmissiveQuad(dir, "lit.gltf", true));
-    lit.build();
-    EXPECT_EQ(lit.environment(), nullptr) << "an emissive material is a light: no sky added";
+  const std::string lit = writeEmissiveQuad(dir, "lit.gltf", true);
+  const std::string dark = writeEmissiveQuad(dir, "dark.gltf", true, false);
+  const std::string screen = writeEmissiveQuad(dir, "screen.gltf", true, true, 1.0);
+  for (const auto& [path, sky] : {std::pair{lit, false}, std::pair{dark, true}, std::pair{screen, true}}) {
+    Scene scene = loadScene(path);
+    scene.build();
+    EXPECT_EQ(scene.environment() != nullptr, sky) << path;
   }
-  {
-    Scene unlit = loadScene(writeEmissiveQuad(dir, "unlit.gltf", true, false));
-    unlit.build();
-    EXPECT_NE(unlit.environment(), nullptr);
+  const auto render = [&](const std::string& path, const std::string& extra) {
+    return test::runEmber("render '" + path + "' -o '" + dir.file("a.exr") + "' --spp 1 --width 8 --height 8 -q " +
+                          extra);
+  };
+  auto r = render(lit, "");
+  EXPECT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("environment: none (" + lit + " is lit by its own emission"), std::string::npos)
+      << r.output;
+  for (const std::string& path : {dark, screen}) {
+    r = render(path, "");
+    EXPECT_NE(r.output.find("environment: white, radiance 1 (" + path + " has no light-giving emission"),
+              std::string::npos)
+        << r.output;
   }
-  const test::CliResult lit = test::runEmber("render '" + dir.file("lit.gltf") + "' -o '" +
-                                             dir.file("a.exr") + "' --spp 1 --width 8 --height 8 -q");
-  EXPECT_EQ(lit.exitCode, 0) << lit.output;
-  EXPECT_EQ(lit.output.find("environment"), std::string::npos) << lit.output;
-  const test::CliResult unlit = test::runEmber("render '" + dir.file("unlit.gltf") + "' -o '" +
-                                               dir.file("b.exr") + "' --spp 1 --width 8 --height 8 -q");
-  EXPECT_EQ(unlit.exitCode, 0) << unlit.output;
-  EXPECT_NE(unlit.output.find("has no lights; lighting it with a uniform white environment"),
-            std::string::npos)
-      << unlit.output;
+  r = render(screen, "--env none");
+  EXPECT_NE(r.output.find("environment: none, black (--env)"), std::string::npos) << r.output;
+  r = render(lit, "--env white --env-strength 0.5");
+  EXPECT_NE(r.output.find("environment: white, radiance 0.5"), std::string::npos) << r.output;
+  r = render(lit, "--env-strength 2");
+  EXPECT_EQ(r.exitCode, 1) << r.output;
+  EXPECT_NE(r.output.find("--env-strength scales the --env light"), std::string::npos) << r.output;
 }
 
 TEST(GltfEmission, InfoCountsDoubleSidedEmitters) {

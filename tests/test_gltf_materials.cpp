@@ -5,6 +5,7 @@
 #include "io/input_error.h"
 #include "io/scene_loader.h"
 #include "materials/texture.h"
+#include "renderer/light.h"
 #include "test_fixtures.h"
 
 #include <gtest/gtest.h>
@@ -394,6 +395,101 @@ TEST(GltfExtensions, UnsupportedRequiredExtensionIsAnErrorAndAnUsedOneAWarning) 
   EXPECT_NE(r.output.find("ignoring unsupported glTF extensions: KHR_materials_diffuse_transmission\n"),
             std::string::npos)
       << r.output;
+}
+
+// An unlit quad (KHR_materials_unlit) whose base colour texture reads TEXCOORD_1, with COLOR_0:
+// the surface emits baseColorFactor x the texel of set 1 x the vertex colour, on camera hits and
+// in light samples alike. Set 0 points at a black texel, so reading the wrong set shows.
+TEST(GltfAttributes, UnlitTexCoord1AndVertexColours) {
+  TempDir dir;
+  GltfBuilder b;
+  tinygltf::Material m = pbr("sign", {0.5, 1.0, 1.0, 1}, 0, 1);
+  m.pbrMetallicRoughness.baseColorTexture.index = b.addTexture(2, 1, 3, {0, 0, 0, 255, 255, 255});
+  m.pbrMetallicRoughness.baseColorTexture.texCoord = 1;
+  m.extensions["KHR_materials_unlit"] = tinygltf::Value(tinygltf::Value::Object{});
+  b.model().extensionsUsed.push_back("KHR_materials_unlit");
+  b.addQuad(1.0f, b.addMaterial(m));
+  const auto constantAttribute = [&](const std::vector<float>& value, int type) {
+    std::vector<float> data;
+    for (int v = 0; v < 4; ++v) data.insert(data.end(), value.begin(), value.end());
+    tinygltf::Accessor accessor;
+    accessor.bufferView = b.addBufferView(data.data(), data.size() * sizeof(float));
+    accessor.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
+    accessor.type = type;
+    accessor.count = 4;
+    b.model().accessors.push_back(accessor);
+    return int(b.model().accessors.size()) - 1;
+  };
+  tinygltf::Primitive& prim = b.model().meshes.at(0).primitives.at(0);
+  prim.attributes["TEXCOORD_0"] = constantAttribute({0.25f, 0.5f}, TINYGLTF_TYPE_VEC2);  // the black texel
+  prim.attributes["TEXCOORD_1"] = constantAttribute({0.75f, 0.5f}, TINYGLTF_TYPE_VEC2);  // the white one
+  prim.attributes["COLOR_0"] = constantAttribute({1.0f, 0.5f, 0.25f, 1.0f}, TINYGLTF_TYPE_VEC4);
+  ASSERT_TRUE(b.write(dir.file("sign.gltf")));
+
+  Scene scene = loadScene(dir.file("sign.gltf"));
+  scene.build();
+  SurfaceHit hit;
+  ASSERT_TRUE(scene.intersect(Ray{Vec3(0.1f, 0.2f, 3.0f), Vec3(0.0f, 0.0f, -1.0f)}, hit));
+  const Color want(0.5f, 0.5f, 0.25f);  // factor (0.5, 1, 1) x white x COLOR_0 (1, 0.5, 0.25)
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(hit.emission[c], want[c], 1e-6f) << c;
+  EXPECT_EQ(hit.material->eval(hit, Vec3(0, 0, 1), Vec3(0, 0.6f, 0.8f)), Color(0.0f)) << "unlit reflects nothing";
+  // The light sample of the same point sees the same radiance.
+  int triangles = 0;
+  for (const auto& light : scene.lights) {
+    if (!dynamic_cast<const TriangleLight*>(light.get())) continue;  // the default environment
+    ++triangles;
+    LightSample ls;
+    if (!light->sample(Vec3(0.1f, 0.2f, 3.0f), Vec2(0.3f, 0.3f), ls)) continue;
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(ls.Li[c], want[c], 1e-6f) << c;
+  }
+  EXPECT_EQ(triangles, 2);
+
+  // A material naming a set the primitive lacks is an error naming both.
+  prim.attributes.erase("TEXCOORD_1");
+  ASSERT_TRUE(b.write(dir.file("bad.gltf")));
+  try {
+    loadScene(dir.file("bad.gltf"));
+    ADD_FAILURE() << "loaded without error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("materials[0].baseColorTexture: texCoord 1 names TEXCOORD_1, which "
+                                         "meshes[0].primitives[0] does not have"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+// COLOR_0 multiplies the base colour of a lit material: a white metal seen head-on reflects
+// f0 = baseColor (Schlick at cos 1), so its eval scales by the vertex colour per channel.
+TEST(GltfAttributes, VertexColoursMultiplyTheBaseColour) {
+  TempDir dir;
+  Color evals[2];
+  for (int coloured = 0; coloured < 2; ++coloured) {
+    GltfBuilder b;
+    b.addQuad(1.0f, b.addMaterial(pbr("metal", {1, 1, 1, 1}, 1, 0.5)));
+    if (coloured) {
+      std::vector<float> data;
+      for (int v = 0; v < 4; ++v) data.insert(data.end(), {0.2f, 0.6f, 1.0f});
+      tinygltf::Accessor accessor;
+      accessor.bufferView = b.addBufferView(data.data(), data.size() * sizeof(float));
+      accessor.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
+      accessor.type = TINYGLTF_TYPE_VEC3;
+      accessor.count = 4;
+      b.model().accessors.push_back(accessor);
+      b.model().meshes.at(0).primitives.at(0).attributes["COLOR_0"] = int(b.model().accessors.size()) - 1;
+    }
+    const std::string path = dir.file("q" + std::to_string(coloured) + ".gltf");
+    ASSERT_TRUE(b.write(path));
+    Scene scene = loadScene(path);
+    scene.build();
+    SurfaceHit hit;
+    ASSERT_TRUE(scene.intersect(Ray{Vec3(0.1f, 0.2f, 3.0f), Vec3(0.0f, 0.0f, -1.0f)}, hit));
+    evals[coloured] = hit.material->eval(hit, Vec3(0, 0, 1), Vec3(0, 0, 1));
+  }
+  ASSERT_GT(evals[0].x, 0.0f);
+  const Color ratio = evals[1] / evals[0];
+  EXPECT_NEAR(ratio.x, 0.2f, 1e-5f);
+  EXPECT_NEAR(ratio.y, 0.6f, 1e-5f);
+  EXPECT_NEAR(ratio.z, 1.0f, 1e-5f);
 }
 
 TEST(GltfOverrides, UnknownMaterialNameListsTheFilesMaterials) {
