@@ -10,11 +10,16 @@ namespace ember::cli {
 
 Runner addInfoCommand(CLI::App& app) {
   auto path = std::make_shared<std::string>();
+  auto variant = std::make_shared<std::string>();
   CLI::App* cmd =
       app.add_subcommand("info", "Print what a scene file loads: shapes, meshes, lights, materials, bounds");
   cmd->add_option("scene", *path, "Scene file: Ember JSON, .gltf or .glb")->required();
-  return [path] {
-    Scene scene = loadScene(*path);
+  cmd->add_option("--variant", *variant,
+                  "glTF files: load the materials of this KHR_materials_variants variant");
+  return [path, variant] {
+    LoadOptions options;
+    options.variant = *variant;
+    Scene scene = loadScene(*path, options);
     const size_t punctualLights = scene.lights.size();  // point, spot, directional: before build() adds more
     scene.build();
     std::map<std::string, int> byType;
@@ -67,6 +72,12 @@ Runner addInfoCommand(CLI::App& app) {
     for (size_t i = 0; i < scene.materials.size(); ++i)
       std::printf("%s %s (%s)", i ? "," : "", scene.materialNames[i].c_str(),
                   std::string(scene.materials[i]->typeName()).c_str());
+    if (!scene.materialVariants.empty()) {
+      std::printf("\nvariants:   %zu", scene.materialVariants.size());
+      for (size_t i = 0; i < scene.materialVariants.size(); ++i)
+        std::printf("%s '%s'", i ? "," : "", scene.materialVariants[i].c_str());
+      std::printf(" (--variant NAME)");
+    }
     std::printf("\nbounds:     (%g, %g, %g) - (%g, %g, %g)\n", b.lower.x, b.lower.y, b.lower.z, b.upper.x,
                 b.upper.y, b.upper.z);
     return 0;

@@ -41,6 +41,7 @@ struct RenderArgs {
   std::string packetWidth = "auto";
   std::string env;
   std::optional<float> envStrength;
+  std::string variant;
   bool quiet = false;
   std::string checkpoint, resume, time;
   double checkpointEvery = 60.0;
@@ -143,9 +144,11 @@ struct RenderSetup {
   std::optional<Checkpoint> resumed;
 };
 
-Scene loadConfigured(const std::string& path, int camera, const std::string& env) {
+Scene loadConfigured(const std::string& path, int camera, const std::string& variant,
+                     const std::string& env) {
   LoadOptions loadOptions;
   loadOptions.camera = camera;
+  loadOptions.variant = variant;
   loadOptions.environmentGiven = !env.empty();
   Scene scene = loadScene(path, loadOptions);
   if (!env.empty()) applyEnvironment(env, scene);
@@ -167,6 +170,7 @@ RenderSetup setUp(RenderArgs& a) {
                                                    {!a.caustics.empty(), "--caustics"},
                                                    {!a.env.empty(), "--env"},
                                                    {a.envStrength.has_value(), "--env-strength"},
+                                                   {!a.variant.empty(), "--variant"},
                                                    {a.camera >= 0, "--camera"},
                                                    {a.firstSample != 0, "--first-sample"},
                                                    {a.passSpp.has_value(), "--pass-spp"}})
@@ -183,7 +187,7 @@ RenderSetup setUp(RenderArgs& a) {
                        EMBER_VERSION +
                        ", whose samples may differ: resume it with the version that wrote it");
     const RenderIdentity& id = c.identity;
-    setup.scene = loadConfigured(id.scene, id.camera, id.env);
+    setup.scene = loadConfigured(id.scene, id.camera, id.variant, id.env);
     RenderSettings& s = setup.scene.settings;
     s.width = id.width;
     s.height = id.height;
@@ -204,7 +208,7 @@ RenderSetup setUp(RenderArgs& a) {
       throw InputError("--spp " + std::to_string(s.spp) + ": the checkpoint's last pass ended at its spp (" +
                        std::to_string(held) + ", not a multiple of the pass size " +
                        std::to_string(c.passSpp) + "), so it cannot be extended");
-    setup.identity = identityOf(setup.scene, id.scene, id.camera, id.env);
+    setup.identity = identityOf(setup.scene, id.scene, id.camera, id.variant, id.env);
     if (const std::string diff = id.differenceFrom(setup.identity); !diff.empty())
       throw InputError(a.resume + ": the checkpoint no longer matches its scene: " + diff);
     if (a.output.empty()) a.output = c.output;
@@ -216,10 +220,11 @@ RenderSetup setUp(RenderArgs& a) {
   if (a.scene.empty()) throw InputError("a scene file is required (or --resume FILE)");
   if (a.output.empty()) throw InputError("-o/--output is required");
   if (a.envStrength) {
-    if (a.env.empty()) throw InputError("--env-strength scales the --env light; give --env too (e.g. --env white)");
+    if (a.env.empty())
+      throw InputError("--env-strength scales the --env light; give --env too (e.g. --env white)");
     a.env += kStrengthTag + std::to_string(*a.envStrength);
   }
-  setup.scene = loadConfigured(a.scene, a.camera, a.env);
+  setup.scene = loadConfigured(a.scene, a.camera, a.variant, a.env);
   RenderSettings& s = setup.scene.settings;
   if (a.spp) s.spp = *a.spp;
   if (a.seed) s.seed = *a.seed;
@@ -230,7 +235,7 @@ RenderSetup setUp(RenderArgs& a) {
   if (a.sampler == "independent") s.sampler = SamplerType::Independent;
   if (!a.strategy.empty()) s.strategy = *parseStrategy(a.strategy);  // CLI11 checked the name
   if (!a.caustics.empty()) s.traceCaustics = a.caustics == "trace";
-  setup.identity = identityOf(setup.scene, a.scene, a.camera, a.env);
+  setup.identity = identityOf(setup.scene, a.scene, a.camera, a.variant, a.env);
   setup.firstSample = a.firstSample;
   setup.passSpp = a.passSpp.value_or(4);
   return setup;
@@ -425,6 +430,9 @@ Runner addRenderCommand(CLI::App& app) {
                   "equirectangular EXR/HDR map; replaces the scene's or the default one");
   cmd->add_option("--env-strength", args->envStrength, "Multiplies the --env light (default 1)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--variant", args->variant,
+                  "glTF files: render the materials of this KHR_materials_variants variant (`ember info` "
+                  "lists them)");
   cmd->add_option("--camera", args->camera,
                   "glTF files: render through camera N of the file's `cameras` (default: the first one a "
                   "node places, else a camera framing the scene)")

@@ -60,6 +60,7 @@ uint64_t RenderIdentity::hash() const {
   feed(s, caustics);
   feedValue(s, camera);
   feed(s, env);
+  if (!variant.empty()) feed(s, variant);  // absent from checkpoints written before variants
   return XXH3_64bits_digest(s);
 }
 
@@ -74,7 +75,8 @@ nlohmann::json RenderIdentity::toJson() const {
   for (const File& f : files) fs.push_back({{"path", f.path}, {"xxh3", hexHash(f.hash)}});
   return {{"scene", scene},        {"files", fs},          {"width", width},   {"height", height},
           {"max_depth", maxDepth}, {"rr_depth", rrDepth},  {"seed", seed},     {"sampler", sampler},
-          {"strategy", strategy},  {"caustics", caustics}, {"camera", camera}, {"env", env}};
+          {"strategy", strategy},  {"caustics", caustics}, {"camera", camera}, {"env", env},
+          {"variant", variant}};
 }
 
 RenderIdentity RenderIdentity::fromJson(const nlohmann::json& j, const std::string& origin) {
@@ -96,6 +98,7 @@ RenderIdentity RenderIdentity::fromJson(const nlohmann::json& j, const std::stri
       throw InputError(origin + ": caustics '" + id.caustics + "' is neither trace nor path");
     id.camera = j.at("camera").get<int>();
     id.env = j.at("env").get<std::string>();
+    id.variant = j.value("variant", std::string());
     if (id.width <= 0 || id.height <= 0 || id.width > 16384 || id.height > 16384)
       throw InputError(origin + ": image size " + std::to_string(id.width) + "x" + std::to_string(id.height) +
                        " is out of range");
@@ -128,11 +131,12 @@ std::string RenderIdentity::differenceFrom(const RenderIdentity& now) const {
   if (caustics != now.caustics) return differs("caustics", caustics, now.caustics);
   if (camera != now.camera) return differs("the camera", camera, now.camera);
   if (env != now.env) return differs("the environment", "'" + env + "'", "'" + now.env + "'");
+  if (variant != now.variant) return differs("the variant", "'" + variant + "'", "'" + now.variant + "'");
   return "";
 }
 
 RenderIdentity identityOf(const Scene& scene, const std::string& sceneArg, int camera,
-                          const std::string& env) {
+                          const std::string& variant, const std::string& env) {
   RenderIdentity id;
   id.scene = sceneArg;
   for (const std::string& f : scene.sourceFiles) id.files.push_back({f, hashFile(f)});
@@ -147,6 +151,7 @@ RenderIdentity identityOf(const Scene& scene, const std::string& sceneArg, int c
   id.caustics = s.traceCaustics ? "trace" : "path";
   id.camera = camera;
   id.env = env;
+  id.variant = variant;
   return id;
 }
 

@@ -27,6 +27,7 @@ struct RenderIdentity {
   std::string caustics = "trace";  // "trace": light-traced caustics (renderer/caustic_tracer.h), "path": not
   int camera = -1;                 // --camera
   std::string env;                 // --env, verbatim (its file, if any, is among `files`)
+  std::string variant;             // --variant (KHR_materials_variants); empty: the default materials
 
   // XXH3-64 over the files' hashes and every setting above: equal iff the renders are the same.
   uint64_t hash() const;
@@ -42,7 +43,7 @@ uint64_t hashFile(const std::string& path);
 
 // The identity of a loaded scene rendered with its settings (and --camera / --env as given).
 RenderIdentity identityOf(const Scene& scene, const std::string& sceneArg, int camera,
-                          const std::string& env);
+                          const std::string& variant, const std::string& env);
 
 // A 16-digit hexadecimal rendering of a hash, as written to EXR metadata.
 std::string hexHash(uint64_t h);

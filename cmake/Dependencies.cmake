@@ -16,3 +16,15 @@ pkg_check_modules(xxhash REQUIRED IMPORTED_TARGET libxxhash)  # content hashes o
 find_package(hwy 1.0 REQUIRED CONFIG)  # Highway: SIMD with run-time dispatch (accel/shape_lanes.cpp)
 # stb_image and stb_image_write (libstb-dev): PNG, JPEG and other 8/16-bit textures in, PNG out.
 pkg_check_modules(stb REQUIRED IMPORTED_TARGET stb)
+# Compressed glTF (io/gltf_compression.cpp): EXT_meshopt_compression (libmeshoptimizer-dev, CMake
+# config), KHR_draco_mesh_compression (libdraco-dev, CMake config) and EXT_texture_webp
+# (libwebp-dev, pkg-config only). Draco is linked statically (draco::draco_static): Debian's
+# libdraco.so.7 exports a tinygltf of its own, another version, whose symbols would take the place
+# of libtinygltf's (Ember crashed in TinyGLTF::LoadASCIIFromString). Only Draco's own objects come
+# from the archive as long as libstb and libtinygltf precede it on the link line, as ember_io lists
+# them (io/CMakeLists.txt): the archive's tiny_gltf_utils.cc.o also defines stb_image, and is
+# pulled in, its tinygltf with it, by any stbi_ or tinygltf symbol still undefined when the linker
+# reaches the archive. GltfCompression.TinygltfIsLibtinygltf checks the unit tests' binary.
+find_package(meshoptimizer REQUIRED CONFIG)
+find_package(draco REQUIRED CONFIG)
+pkg_check_modules(webp REQUIRED IMPORTED_TARGET libwebp)

@@ -35,7 +35,9 @@ struct SurfaceHit {
   Vec2 bary{0.0f};  // barycentrics (b1, b2) within triangle `prim`
 
   // Texture coordinates of set `set`: uv for set 0, and on shapes without further sets.
-  Vec2 texCoord(int set) const { return set == 0 || !attributes ? uv : attributes->texCoordAt(set, prim, bary); }
+  Vec2 texCoord(int set) const {
+    return set == 0 || !attributes ? uv : attributes->texCoordAt(set, prim, bary);
+  }
   // The vertex colour, white without one.
   glm::vec4 vertexColor() const { return attributes ? attributes->colorAt(prim, bary) : glm::vec4(1.0f); }
 

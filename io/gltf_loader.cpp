@@ -2,6 +2,7 @@
 
 #include "accel/cylinder.h"
 #include "accel/sphere.h"
+#include "io/gltf_compression.h"
 #include "io/gltf_materials.h"
 #include "io/input_error.h"
 
@@ -35,6 +36,7 @@ class GltfImporter {
   GltfImport run() {
     load();
     checkVersion(model_.asset.version, model_.asset.minVersion);
+    decodeCompressedData(model_, path_);  // meshopt, Draco, WebP: plain data from here on
     checkPrimitiveArrays();
     checkExtensions();
     result_.cameraCount = model_.cameras.size();
@@ -54,6 +56,7 @@ class GltfImporter {
         fail("materials",
              "no material named '" + name + "'; the file has: " + (known.empty() ? "none" : known));
       }
+    readVariants();
     std::vector<int> roots;
     if (!model_.scenes.empty()) {
       int sceneIndex = model_.defaultScene;
@@ -70,6 +73,8 @@ class GltfImporter {
     const size_t firstMesh = scene_.meshes.size();
     for (int root : roots) visit(root, options_.transform, stack);
     makePointsAndLines(firstMesh);
+    scene_.materialVariants.insert(scene_.materialVariants.end(), result_.variants.begin(),
+                                   result_.variants.end());
     if (options_.camera >= 0 && !result_.camera)
       fail("cameras[" + std::to_string(options_.camera) + "]", "no node of the scene uses this camera");
     return result_;
@@ -96,15 +101,32 @@ class GltfImporter {
     tinygltf::FsCallbacks callbacks{&tinygltf::FileExists, &tinygltf::ExpandFilePath, &recordingRead,
                                     &tinygltf::WriteWholeFile, &scene_.sourceFiles};
     loader.SetFsCallbacks(callbacks);
+    loader.SetImageLoader(gltfImageLoader(), &model_);  // WebP and KTX2 too (io/gltf_compression.h)
     std::string err, warn;
     std::string ext = fs::path(path_).extension().string();
     for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-    const bool ok = ext == ".glb" ? loader.LoadBinaryFromFile(&model_, &err, &warn, path_)
-                                  : loader.LoadASCIIFromFile(&model_, &err, &warn, path_);
+    const size_t recorded = scene_.sourceFiles.size();
+    bool ok = ext == ".glb" ? loader.LoadBinaryFromFile(&model_, &err, &warn, path_)
+                            : loader.LoadASCIIFromFile(&model_, &err, &warn, path_);
+    // tinygltf refuses Draco primitives' indices without a bufferView and meshopt fallback buffers
+    // without data: retried with those patched out (io/gltf_compression.h), from memory.
+    if (const auto patched = ok ? std::nullopt : patchCompressedGltf(path_)) {
+      scene_.sourceFiles.resize(recorded);  // read again below, the file itself by us
+      scene_.sourceFiles.push_back(path_);
+      model_ = tinygltf::Model();
+      err.clear();
+      const size_t slash = path_.find_last_of("/\\");
+      const std::string dir = slash == std::string::npos ? "" : path_.substr(0, slash);  // as tinygltf's
+      ok = ext == ".glb" ? loader.LoadBinaryFromMemory(
+                               &model_, &err, &warn, reinterpret_cast<const unsigned char*>(patched->data()),
+                               unsigned(patched->size()), dir)
+                         : loader.LoadASCIIFromString(&model_, &err, &warn, patched->data(),
+                                                      unsigned(patched->size()), dir);
+    }
     if (!ok) {
       // tinygltf trips over glTF 1.0's schema and over the data of extensions it cannot decode
-      // (Draco's missing bufferViews) before we see the file's version and extensionsRequired:
-      // name the cause rather than its symptom.
+      // before we see the file's version and extensionsRequired: name the cause rather than its
+      // symptom.
       const nlohmann::json doc = fileJson();
       if (doc.is_object() && doc.contains("asset") && doc["asset"].is_object()) {
         const nlohmann::json& asset = doc["asset"];
@@ -130,12 +152,12 @@ class GltfImporter {
 
   static const std::set<std::string>& supportedExtensions() {
     static const std::set<std::string> supported = {
-        "KHR_lights_punctual",        "KHR_materials_emissive_strength",
-        "KHR_materials_transmission", "KHR_materials_ior",
-        "KHR_materials_volume",       "KHR_texture_transform",
-        "KHR_materials_specular",     "KHR_materials_sheen",
-        "KHR_materials_clearcoat",    "KHR_materials_unlit",
-        "KHR_mesh_quantization"};
+        "KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_transmission",
+        "KHR_materials_ior", "KHR_materials_volume", "KHR_texture_transform", "KHR_materials_specular",
+        "KHR_materials_sheen", "KHR_materials_clearcoat", "KHR_materials_unlit", "KHR_materials_iridescence",
+        "KHR_materials_variants", "KHR_mesh_quantization",
+        // io/gltf_compression.cpp; KHR_texture_basisu by its textures' PNG/JPEG fallbacks alone.
+        "EXT_meshopt_compression", "KHR_draco_mesh_compression", "EXT_texture_webp", "KHR_texture_basisu"};
     return supported;
   }
 
@@ -232,6 +254,57 @@ class GltfImporter {
                    ignored.c_str());
   }
 
+  // KHR_materials_variants: the file's variant names, and the index of the one asked for.
+  void readVariants() {
+    const auto ext = model_.extensions.find("KHR_materials_variants");
+    if (ext != model_.extensions.end()) {
+      const tinygltf::Value& variants = ext->second.Get("variants");
+      if (!variants.IsArray()) fail("extensions.KHR_materials_variants.variants", "expected an array");
+      for (size_t i = 0; i < variants.ArrayLen(); ++i) {
+        const tinygltf::Value& name = variants.Get(int(i)).Get("name");
+        if (!name.IsString())
+          fail("extensions.KHR_materials_variants.variants[" + std::to_string(i) + "].name",
+               "expected a string");
+        result_.variants.push_back(name.Get<std::string>());
+      }
+    }
+    if (options_.variant.empty()) return;
+    for (size_t i = 0; i < result_.variants.size(); ++i)
+      if (result_.variants[i] == options_.variant) variant_ = int(i);
+    if (variant_ < 0) {
+      std::string known;
+      for (const std::string& v : result_.variants)
+        known.append(known.empty() ? "'" : ", '").append(v).append("'");
+      fail("extensions.KHR_materials_variants",
+           "no variant named '" + options_.variant + "'; the file has: " + (known.empty() ? "none" : known));
+    }
+  }
+
+  // The material a primitive takes: the chosen variant's where the primitive maps it
+  // (KHR_materials_variants mappings), else its own.
+  int materialOf(const tinygltf::Primitive& prim, const std::string& where) const {
+    if (variant_ < 0) return prim.material;
+    const auto ext = prim.extensions.find("KHR_materials_variants");
+    if (ext == prim.extensions.end()) return prim.material;
+    const std::string w = where + ".extensions.KHR_materials_variants.mappings";
+    const tinygltf::Value& mappings = ext->second.Get("mappings");
+    if (!mappings.IsArray()) fail(w, "expected an array");
+    for (size_t i = 0; i < mappings.ArrayLen(); ++i) {
+      const tinygltf::Value& mapping = mappings.Get(int(i));
+      const tinygltf::Value& variants = mapping.Get("variants");
+      const tinygltf::Value& material = mapping.Get("material");
+      const std::string wi = w + "[" + std::to_string(i) + "]";
+      if (!variants.IsArray()) fail(wi + ".variants", "expected an array");
+      if (!material.IsNumber() || material.GetNumberAsDouble() < 0.0 ||
+          material.GetNumberAsDouble() >= double(model_.materials.size()))
+        fail(wi + ".material", "expected a material index below " + std::to_string(model_.materials.size()));
+      for (size_t k = 0; k < variants.ArrayLen(); ++k)
+        if (variants.Get(int(k)).IsNumber() && variants.Get(int(k)).GetNumberAsInt() == variant_)
+          return material.GetNumberAsInt();
+    }
+    return prim.material;
+  }
+
   static Mat4 localMatrix(const tinygltf::Node& node) {
     if (node.matrix.size() == 16) {
       Mat4 m;
@@ -326,11 +399,17 @@ class GltfImporter {
       fail(where, "light colour and intensity must be finite and >= 0");
     const Vec3 position(world * glm::vec4(0, 0, 0, 1));
     const Vec3 direction = glm::normalize(Vec3(world * glm::vec4(0, 0, -1, 0)));  // lights shine along -z
+    // `range` (0: infinite) is a world distance: "light properties are unaffected by node
+    // transforms" (KHR_lights_punctual).
+    const float range = float(l.range);
+    if (!(l.range >= 0.0 && std::isfinite(range)))
+      fail("lights[" + std::to_string(index) + "].range", "expected a number > 0 (or none, for infinite)");
     if (l.type == "point") {
-      scene_.lights.push_back(std::make_unique<PointLight>(position, radiometric));
+      scene_.lights.push_back(std::make_unique<PointLight>(position, radiometric, range));
     } else if (l.type == "spot") {
-      scene_.lights.push_back(std::make_unique<SpotLight>(
-          position, direction, radiometric, float(l.spot.innerConeAngle), float(l.spot.outerConeAngle)));
+      scene_.lights.push_back(std::make_unique<SpotLight>(position, direction, radiometric,
+                                                          float(l.spot.innerConeAngle),
+                                                          float(l.spot.outerConeAngle), range));
     } else if (l.type == "directional") {
       scene_.lights.push_back(std::make_unique<DirectionalLight>(-direction, radiometric));
     } else {
@@ -536,7 +615,7 @@ class GltfImporter {
 
   void readPointsOrLines(const tinygltf::Primitive& prim, int mode, const Mat4& world,
                          const std::vector<float>& positions, size_t vertexCount, const std::string& where) {
-    PointsOrLines item{{}, {}, prim.material, where};
+    PointsOrLines item{{}, {}, materialOf(prim, where), where};
     for (size_t i = 0; i < vertexCount; ++i)
       item.points.push_back(
           Vec3(world * glm::vec4(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2], 1.0f)));
@@ -647,7 +726,8 @@ class GltfImporter {
     if (const auto col = prim.attributes.find("COLOR_0"); col != prim.attributes.end()) {
       const std::string w = where + ".attributes.COLOR_0";
       const tinygltf::Accessor& acc = checkedAccessor(col->second, w);
-      if (acc.type != TINYGLTF_TYPE_VEC3 && acc.type != TINYGLTF_TYPE_VEC4) fail(w, "expected a VEC3 or VEC4 accessor");
+      if (acc.type != TINYGLTF_TYPE_VEC3 && acc.type != TINYGLTF_TYPE_VEC4)
+        fail(w, "expected a VEC3 or VEC4 accessor");
       const int components = acc.type == TINYGLTF_TYPE_VEC4 ? 4 : 3;
       size_t n = 0;
       const std::vector<float> colors = readFloats(col->second, acc.type, w, n);
@@ -692,16 +772,18 @@ class GltfImporter {
 
     result_.triangles += mesh->indices.size();
     ++result_.primitives;
-    const GltfSurface& surface = materials_.surface(prim.material, !mesh->colors.empty());
+    const int materialIndex = materialOf(prim, where);
+    const GltfSurface& surface = materials_.surface(materialIndex, !mesh->colors.empty());
     if (surface.maxTexCoord >= mesh->texCoordSetCount())
       fail(surface.maxTexCoordWhere, "texCoord " + std::to_string(surface.maxTexCoord) + " names TEXCOORD_" +
-                                         std::to_string(surface.maxTexCoord) + ", which " + where + " does not have");
+                                         std::to_string(surface.maxTexCoord) + ", which " + where +
+                                         " does not have");
     if (surface.needsTangents && mesh->tangents.empty()) mesh->generateTangents();
     const Material* material = surface.material;
     if (options_.materialOverride) {
       material = options_.materialOverride;
-    } else if (prim.material >= 0 && size_t(prim.material) < model_.materials.size()) {
-      const auto it = options_.materialsByName.find(model_.materials[size_t(prim.material)].name);
+    } else if (materialIndex >= 0 && size_t(materialIndex) < model_.materials.size()) {
+      const auto it = options_.materialsByName.find(model_.materials[size_t(materialIndex)].name);
       if (it != options_.materialsByName.end()) material = it->second;
     }
     mesh->opacity = surface.opacity;
@@ -731,6 +813,7 @@ class GltfImporter {
   GltfImport result_;
   std::set<std::string> usedOverrides_;
   std::vector<PointsOrLines> pointsAndLines_;
+  int variant_ = -1;  // index of options_.variant among the file's variants
 };
 
 }  // namespace

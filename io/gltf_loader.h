@@ -19,6 +19,9 @@ struct GltfImportOptions {
   const Material* materialOverride = nullptr;              // replaces every glTF material when set
   std::map<std::string, const Material*> materialsByName;  // replaces glTF materials by name
   int camera = -1;  // index into the file's `cameras`; -1: the first camera met in the node tree
+  // KHR_materials_variants: the variant whose materials primitives take where they map one;
+  // empty: every primitive's default material.
+  std::string variant;
 };
 
 struct GltfImport {
@@ -30,6 +33,7 @@ struct GltfImport {
   size_t primitives = 0;
   size_t lights = 0;                       // KHR_lights_punctual lights placed by nodes
   std::vector<std::string> materialNames;  // every glTF material's name, in file order
+  std::vector<std::string> variants;       // KHR_materials_variants names, in file order
 };
 
 // Appends the file's meshes, materials and lights to `scene`.

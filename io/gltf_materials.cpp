@@ -58,10 +58,11 @@ const GltfSurface& GltfMaterialReader::surface(int index, bool vertexColors) {
   return out;
 }
 
-std::shared_ptr<const Texture> GltfMaterialReader::extensionTexture(const tinygltf::Value& ext, const char* key,
-                                                                    Channels channels, const Color& scale,
-                                                                    const std::string& where, GltfSurface& out,
-                                                                    float* normalScale) {
+std::shared_ptr<const Texture> GltfMaterialReader::extensionTexture(const tinygltf::Value& ext,
+                                                                    const char* key, Channels channels,
+                                                                    const Color& scale,
+                                                                    const std::string& where,
+                                                                    GltfSurface& out, float* normalScale) {
   (void)out;
   if (!ext.Has(key)) return nullptr;
   const std::string w = where + "." + key;
@@ -75,15 +76,16 @@ std::shared_ptr<const Texture> GltfMaterialReader::extensionTexture(const tinygl
     *normalScale = numberOr(info, "scale", 1.0f);
     if (!std::isfinite(*normalScale)) fail(w + ".scale", "expected a number");
   }
-  return texture(int(tex), int(texCoord), info.Has("extensions") ? extensionsOf(info) : tinygltf::ExtensionMap{},
-                 channels, scale, w);
+  return texture(int(tex), int(texCoord),
+                 info.Has("extensions") ? extensionsOf(info) : tinygltf::ExtensionMap{}, channels, scale, w);
 }
 
 namespace {
 
 // A factor array of `n` finite numbers (KHR extension colours), or `fallback` without one.
-Color colorFactor(const tinygltf::Value& ext, const char* key, const Color& fallback, const std::string& where,
-                  float maxValue, const std::function<void(const std::string&, const std::string&)>& fail) {
+Color colorFactor(const tinygltf::Value& ext, const char* key, const Color& fallback,
+                  const std::string& where, float maxValue,
+                  const std::function<void(const std::string&, const std::string&)>& fail) {
   if (!ext.Has(key)) return fallback;
   const tinygltf::Value& c = ext.Get(key);
   if (!c.IsArray() || c.ArrayLen() != 3) fail(where + "." + key, "expected 3 numbers");
@@ -91,7 +93,8 @@ Color colorFactor(const tinygltf::Value& ext, const char* key, const Color& fall
   for (int k = 0; k < 3; ++k) {
     out[k] = c.Get(k).IsNumber() ? float(c.Get(k).GetNumberAsDouble()) : -1.0f;
     if (!(out[k] >= 0.0f && out[k] <= maxValue))
-      fail(where + "." + key, "expected numbers in [0, " + (maxValue > 1e30f ? std::string("inf") : "1") + ")");
+      fail(where + "." + key,
+           "expected numbers in [0, " + (maxValue > 1e30f ? std::string("inf") : "1") + ")");
   }
   return out;
 }
@@ -164,18 +167,40 @@ GltfSurface GltfMaterialReader::convert(int index, bool vertexColors) {
     in.specular = extensionTexture(*ext, "specularTexture", Channels::Alpha, Color(factor), w, out);
     if (!in.specular && factor != 1.0f) in.specular = std::make_shared<ConstantTexture>(Color(factor));
     in.specularColor = extensionTexture(*ext, "specularColorTexture", Channels::SrgbRgb, color, w, out);
-    if (!in.specularColor && color != Color(1.0f)) in.specularColor = std::make_shared<ConstantTexture>(color);
+    if (!in.specularColor && color != Color(1.0f))
+      in.specularColor = std::make_shared<ConstantTexture>(color);
   }
   // KHR_materials_sheen: colour (sRGB RGB) and roughness (alpha) textures.
   if (const tinygltf::Value* ext = extension(m.extensions, "KHR_materials_sheen")) {
     const std::string w = where + ".extensions.KHR_materials_sheen";
     const Color color = colorFactor(*ext, "sheenColorFactor", Color(0.0f), w, 1.0f, failAt);
     const float roughness = numberOr(*ext, "sheenRoughnessFactor", 0.0f);
-    if (!(roughness >= 0.0f && roughness <= 1.0f)) fail(w + ".sheenRoughnessFactor", "expected a number in [0, 1]");
+    if (!(roughness >= 0.0f && roughness <= 1.0f))
+      fail(w + ".sheenRoughnessFactor", "expected a number in [0, 1]");
     in.sheenColor = extensionTexture(*ext, "sheenColorTexture", Channels::SrgbRgb, color, w, out);
     if (!in.sheenColor && !isBlack(color)) in.sheenColor = std::make_shared<ConstantTexture>(color);
-    in.sheenRoughness = extensionTexture(*ext, "sheenRoughnessTexture", Channels::Alpha, Color(roughness), w, out);
+    in.sheenRoughness =
+        extensionTexture(*ext, "sheenRoughnessTexture", Channels::Alpha, Color(roughness), w, out);
     if (!in.sheenRoughness) in.sheenRoughness = std::make_shared<ConstantTexture>(Color(roughness));
+  }
+  // KHR_materials_iridescence: weight (R), thickness (G) between the minimum and maximum, the
+  // film's ior.
+  if (const tinygltf::Value* ext = extension(m.extensions, "KHR_materials_iridescence")) {
+    const std::string w = where + ".extensions.KHR_materials_iridescence";
+    const float factor = numberOr(*ext, "iridescenceFactor", 0.0f);
+    if (!(factor >= 0.0f && factor <= 1.0f)) fail(w + ".iridescenceFactor", "expected a number in [0, 1]");
+    in.iridescenceIor = numberOr(*ext, "iridescenceIor", 1.3f);
+    if (!(in.iridescenceIor >= 1.0f && in.iridescenceIor < 10.0f))
+      fail(w + ".iridescenceIor", "expected a number in [1, 10)");
+    in.iridescenceThicknessMin = numberOr(*ext, "iridescenceThicknessMinimum", 100.0f);
+    in.iridescenceThicknessMax = numberOr(*ext, "iridescenceThicknessMaximum", 400.0f);
+    for (const auto& [key, value] : {std::pair{"iridescenceThicknessMinimum", in.iridescenceThicknessMin},
+                                     std::pair{"iridescenceThicknessMaximum", in.iridescenceThicknessMax}})
+      if (!(value >= 0.0f && value < 1e6f)) fail(w + "." + key, "expected a thickness >= 0 (nm)");
+    in.iridescence = extensionTexture(*ext, "iridescenceTexture", Channels::Red, Color(factor), w, out);
+    if (!in.iridescence && factor > 0.0f) in.iridescence = std::make_shared<ConstantTexture>(Color(factor));
+    in.iridescenceThickness =
+        extensionTexture(*ext, "iridescenceThicknessTexture", Channels::Green, Color(1.0f), w, out);
   }
   // KHR_materials_clearcoat: weight (R), roughness (G) and a normal map of the coat's own.
   if (const tinygltf::Value* ext = extension(m.extensions, "KHR_materials_clearcoat")) {
@@ -190,8 +215,8 @@ GltfSurface GltfMaterialReader::convert(int index, bool vertexColors) {
     in.clearcoatRoughness =
         extensionTexture(*ext, "clearcoatRoughnessTexture", Channels::Green, Color(roughness), w, out);
     if (!in.clearcoatRoughness) in.clearcoatRoughness = std::make_shared<ConstantTexture>(Color(roughness));
-    in.clearcoatNormal = extensionTexture(*ext, "clearcoatNormalTexture", Channels::LinearRgb, Color(1.0f), w, out,
-                                          &in.clearcoatNormalScale);
+    in.clearcoatNormal = extensionTexture(*ext, "clearcoatNormalTexture", Channels::LinearRgb, Color(1.0f), w,
+                                          out, &in.clearcoatNormalScale);
     out.needsTangents = in.clearcoatNormal != nullptr;
   }
   if (const tinygltf::Value* ext = extension(m.extensions, "KHR_materials_volume")) {
@@ -252,11 +277,12 @@ GltfSurface GltfMaterialReader::convert(int index, bool vertexColors) {
   // which a path tracer renders as a black surface emitting that colour: seen directly and in
   // reflections, as viewers show it, and lighting what faces it by that much.
   if (extension(m.extensions, "KHR_materials_unlit")) {
-    out.material = scene_.addMaterial(name + " (unlit)", std::make_unique<Lambertian>(
-                                                             std::make_shared<ConstantTexture>(Color(0.0f))));
+    out.material = scene_.addMaterial(
+        name + " (unlit)", std::make_unique<Lambertian>(std::make_shared<ConstantTexture>(Color(0.0f))));
     out.emission = baseRgb;
     maps->normalMap = nullptr;
-    maps->emission = texture(pbr.baseColorTexture, Channels::SrgbRgb, Color(1.0f), where + ".baseColorTexture");
+    maps->emission =
+        texture(pbr.baseColorTexture, Channels::SrgbRgb, Color(1.0f), where + ".baseColorTexture");
     if (vertexColors)
       maps->emission = std::make_shared<VertexColorTexture>(
           maps->emission ? maps->emission : std::make_shared<ConstantTexture>(Color(1.0f)));

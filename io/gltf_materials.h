@@ -21,8 +21,8 @@ struct GltfSurface {
   int maxTexCoord = 0;
   std::string maxTexCoordWhere;
   bool needsTangents = false;  // a normal map other than the surface's own reads tangents (the coat's)
-  Color emission{0.0f};      // emissiveFactor x emissiveStrength
-  bool doubleSided = false;  // both faces emit (and are shaded with the normal facing the viewer)
+  Color emission{0.0f};        // emissiveFactor x emissiveStrength
+  bool doubleSided = false;    // both faces emit (and are shaded with the normal facing the viewer)
   std::shared_ptr<const SurfaceMaps> maps;
   std::shared_ptr<const MeshOpacity> opacity;
 };
@@ -46,8 +46,9 @@ class GltfMaterialReader {
 
   GltfSurface convert(int index, bool vertexColors);
   // The textureInfo `key` of an extension object (a plain JSON value), or null without one.
-  std::shared_ptr<const Texture> extensionTexture(const tinygltf::Value& ext, const char* key, Channels channels,
-                                                  const Color& scale, const std::string& where, GltfSurface& out,
+  std::shared_ptr<const Texture> extensionTexture(const tinygltf::Value& ext, const char* key,
+                                                  Channels channels, const Color& scale,
+                                                  const std::string& where, GltfSurface& out,
                                                   float* normalScale = nullptr);
   std::shared_ptr<const Texture> texture(const tinygltf::TextureInfo& info, Channels channels,
                                          const Color& scale, const std::string& where);

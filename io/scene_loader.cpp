@@ -328,7 +328,7 @@ class JsonSceneLoader {
         s.at("vertices").fail("the four vertices of a quad must lie in one plane");
       shape = std::make_unique<Quad>(v, uv);
     } else if (type == "mesh") {
-      common({"file", "transform", "materials"});
+      common({"file", "transform", "materials", "variant"});
       if (s.has("flip_normals")) s.at("flip_normals").fail("not supported for meshes");
       readMesh(s, emission);
       return;
@@ -409,6 +409,7 @@ class JsonSceneLoader {
       for (auto it = byName->raw().begin(); it != byName->raw().end(); ++it)
         options.materialsByName[it.key()] = materialNamed(byName->at(it.key()));
     }
+    if (auto variant = s.find("variant")) options.variant = variant->string();
     const size_t first = scene_.meshes.size();
     try {
       importGltf(meshPath.string(), scene_, options);
@@ -484,6 +485,7 @@ Scene loadGltfScene(const std::string& path, const LoadOptions& load) {
   scene.sourcePath = path;
   GltfImportOptions options;
   options.camera = load.camera;
+  options.variant = load.variant;
   const GltfImport imported = importGltf(path, scene, options);
   if (imported.triangles + imported.points + imported.segments == 0)
     throw InputError(path + ": the scene contains nothing to render");
@@ -517,8 +519,8 @@ Scene loadGltfScene(const std::string& path, const LoadOptions& load) {
                    "--env none|white|r,g,b|FILE overrides)\n",
                    path.c_str());
     } else {
-      std::fprintf(stderr, "ember: environment: none (%s is lit by its own %s; --env adds one)\n", path.c_str(),
-                   imported.lights ? "KHR lights" : "emission");
+      std::fprintf(stderr, "ember: environment: none (%s is lit by its own %s; --env adds one)\n",
+                   path.c_str(), imported.lights ? "KHR lights" : "emission");
     }
   }
   return scene;
@@ -538,6 +540,10 @@ Scene loadJsonScene(const std::string& path) {
 Scene loadScene(const std::string& path, const LoadOptions& options) {
   if (!fs::exists(path)) throw InputError(path + ": no such file");
   if (fs::is_directory(path)) throw InputError(path + ": is a directory, not a scene file");
+  if (!isGltfPath(path) && !options.variant.empty())
+    throw InputError(path +
+                     ": --variant selects a KHR_materials_variants variant of a glTF file; in a JSON scene "
+                     "a mesh entry takes \"variant\"");
   if (!isGltfPath(path) && options.camera >= 0)
     throw InputError(path + ": --camera selects a camera of a glTF file; a JSON scene has one camera");
   return isGltfPath(path) ? loadGltfScene(path, options) : loadJsonScene(path);

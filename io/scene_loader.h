@@ -12,6 +12,7 @@ namespace ember {
 struct LoadOptions {
   int camera = -1;  // glTF files: index into the file's cameras (-1: the first one placed by a node)
   bool environmentGiven = false;  // the caller sets an environment (--env): no default sky for glTF
+  std::string variant;            // glTF files: a KHR_materials_variants variant (--variant)
 };
 
 Scene loadScene(const std::string& path, const LoadOptions& options = {});

@@ -35,6 +35,11 @@
 //    weight uses n_c.v, as the extension defines it, so the coated BSDF is not reciprocal.
 //    Emission under a coat is not darkened by it (the extension suggests so; Ember's emission is the
 //    surface's, read before any material).
+//  - KHR_materials_iridescence mixes the thin-film reflectance into the dielectric's and the
+//    metal's Fresnel for reflection and thin-walled transmission; the refraction lobe of a volume
+//    keeps Schlick's (the film's weight is no reason to break its reciprocity), and the lobe
+//    probabilities use Schlick's, which only steer sampling. The optical path difference takes the
+//    angle inside the film (Belcour & Barla's code; the extension's text writes cos theta_1).
 //  - Sampling: a one-sample mixture of cosine-weighted diffuse, GGX visible normals (Heitz 2018)
 //    reflected, (transmission > 0) the same visible normal refracted or reflected-and-mirrored,
 //    uniform hemisphere directions for the sheen and the coat's own visible normals. Lobe
@@ -58,6 +63,7 @@
 #include "core/sampling.h"
 #include "materials/fresnel.h"
 #include "materials/hit_memo.h"
+#include "materials/iridescence.h"
 #include "materials/sheen.h"
 #include "materials/surface_maps.h"
 
@@ -68,7 +74,9 @@ namespace {
 // KHR_materials_clearcoat's layer is a dielectric of ior 1.5: f0 = ((1.5 - 1) / (1.5 + 1))^2.
 constexpr float kCoatF0 = 0.04f;
 
-float maxOf(const Color& c) { return std::max(c.x, std::max(c.y, c.z)); }
+float maxOf(const Color& c) {
+  return std::max(c.x, std::max(c.y, c.z));
+}
 
 }  // namespace
 
@@ -84,6 +92,7 @@ GltfPbrMaterial::GltfPbrMaterial(GltfPbrInputs inputs) : inputs_(std::move(input
   refracts_ = !inputs_.thinWalled && ior_ > 1.0f + 1e-3f;
   sheen_ = inputs_.sheenColor && !isBlack(inputs_.sheenColor->maxValue());
   coat_ = inputs_.clearcoat && inputs_.clearcoat->maxValue().x > 0.0f;
+  film_ = inputs_.iridescence && inputs_.iridescence->maxValue().x > 0.0f;
 }
 
 const GltfPbrMaterial::Params& GltfPbrMaterial::fetchFor(const SurfaceHit& hit) const {
@@ -101,8 +110,8 @@ GltfPbrMaterial::Params GltfPbrMaterial::fetch(const SurfaceHit& hit) const {
     p.metallic = std::clamp(mr.b, 0.0f, 1.0f);
   }
   if (inputs_.transmission) p.transmission = std::clamp(inputs_.transmission->evalAt(hit).r, 0.0f, 1.0f);
-  const Color specularColor = inputs_.specularColor ? glm::max(inputs_.specularColor->evalAt(hit), Color(0.0f))
-                                                    : Color(1.0f);
+  const Color specularColor =
+      inputs_.specularColor ? glm::max(inputs_.specularColor->evalAt(hit), Color(0.0f)) : Color(1.0f);
   p.specularF0 = glm::min(f0_ * specularColor, Color(1.0f));
   if (inputs_.specular) p.specularWeight = std::clamp(inputs_.specular->evalAt(hit).r, 0.0f, 1.0f);
   if (sheen_) {
@@ -121,6 +130,14 @@ GltfPbrMaterial::Params GltfPbrMaterial::fetch(const SurfaceHit& hit) const {
                                      hit.attributes->tangentAt(hit.prim, hit.bary),
                                      hit.texCoord(inputs_.clearcoatNormal->texCoordSet()));
     p.coatNormal = glm::dot(n, hit.ng) < 0.0f ? -n : n;
+  }
+  if (film_) {
+    p.iridescence = std::clamp(inputs_.iridescence->evalAt(hit).r, 0.0f, 1.0f);
+    const float t = inputs_.iridescenceThickness
+                        ? std::clamp(inputs_.iridescenceThickness->evalAt(hit).r, 0.0f, 1.0f)
+                        : 1.0f;
+    p.filmThickness = inputs_.iridescenceThicknessMin +
+                      (inputs_.iridescenceThicknessMax - inputs_.iridescenceThicknessMin) * t;
   }
   return p;
 }
@@ -145,7 +162,8 @@ float GltfPbrMaterial::coatWeight(const Params& p, const Frames& f) const {
   return p.clearcoat * schlickFresnel(kCoatF0, f.oc.z);
 }
 
-GltfPbrMaterial::LobeProbabilities GltfPbrMaterial::lobeProbabilities(const Params& p, const Frames& f) const {
+GltfPbrMaterial::LobeProbabilities GltfPbrMaterial::lobeProbabilities(const Params& p,
+                                                                      const Frames& f) const {
   const float cosO = f.o.z;
   // The layer's Fresnel term at n.v, capped below 1 inside a volume: past the critical angle most
   // visible microfacets reflect totally, but those tilted towards wo still refract, so the
@@ -175,8 +193,23 @@ Color GltfPbrMaterial::dielectricFresnel(const Params& p, float cosOH, bool outs
   return schlickFresnel(p.specularF0, std::sqrt(1.0f - sin2T));
 }
 
-Color GltfPbrMaterial::evalBase(const Params& p, const LobeProbabilities& lobes, const Vec3& o,
-                                const Vec3& i, bool reflection, bool outside, float& pdf) const {
+void GltfPbrMaterial::reflectances(const Params& p, float cosOH, bool outside, Color& dielectric,
+                                   Color& metal) const {
+  dielectric = dielectricFresnel(p, cosOH, outside);
+  metal = schlickFresnel(p.baseColor, cosOH);
+  if (!(p.iridescence > 0.0f) || (refracts_ && !outside)) return;
+  // The film lies on the outer surface, under the coat if there is one (whose ior, 1.5, is then
+  // the outside medium's, as the extension says).
+  const float outsideIor = p.clearcoat > 0.0f ? 1.5f : 1.0f;
+  const float ior = inputs_.iridescenceIor;
+  dielectric = glm::mix(dielectric, thinFilmFresnel(outsideIor, ior, cosOH, p.filmThickness, p.specularF0),
+                        p.iridescence);
+  metal =
+      glm::mix(metal, thinFilmFresnel(outsideIor, ior, cosOH, p.filmThickness, p.baseColor), p.iridescence);
+}
+
+Color GltfPbrMaterial::evalBase(const Params& p, const LobeProbabilities& lobes, const Vec3& o, const Vec3& i,
+                                bool reflection, bool outside, float& pdf) const {
   pdf = 0.0f;
   const Ggx& g = p.ggx;
   const float dielectric = 1.0f - p.metallic;
@@ -185,8 +218,9 @@ Color GltfPbrMaterial::evalBase(const Params& p, const LobeProbabilities& lobes,
     const Vec3 h = glm::normalize(o + i);  // o.z, i.z > 0: the sum is never zero
     const float cosOH = glm::dot(o, h);
     const float specular = g.D(h) * g.V(o, i);  // specular_brdf = D V (glTF B.3.2)
-    const Color fd = p.specularWeight * dielectricFresnel(p, cosOH, outside);
-    const Color fm = schlickFresnel(p.baseColor, cosOH);
+    Color fd, fm;
+    reflectances(p, cosOH, outside, fd, fm);
+    fd *= p.specularWeight;
     // mix(fresnel_mix(base, specular), conductor_fresnel(specular), metallic), base = the diffuse
     // part only (the BTDF is zero for a reflection).
     const Color f =
@@ -202,7 +236,9 @@ Color GltfPbrMaterial::evalBase(const Params& p, const LobeProbabilities& lobes,
     // Thin-walled: the reflection lobe of the mirrored direction (flip along the normal).
     const Vec3 m(i.x, i.y, -i.z);
     const Vec3 h = glm::normalize(o + m);
-    const float fd = p.specularWeight * maxOf(schlickFresnel(p.specularF0, glm::dot(o, h)));
+    Color fr, fm;
+    reflectances(p, glm::dot(o, h), outside, fr, fm);
+    const float fd = p.specularWeight * maxOf(fr);
     pdf = lobes.transmission * g.reflectionPdf(o, h);
     return (scale * (1.0f - fd) * g.D(h) * g.V(o, m) * m.z) * p.baseColor;
   }
@@ -298,7 +334,9 @@ bool GltfPbrMaterial::sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, floa
   float eta = 1.0f;
   float edge = lobes.coat;
   if (uLobe < edge) {
-    wi = f.coat.toWorld(reflect(f.oc, p.coatGgx.sampleVisibleNormal(f.oc, u)));
+    const Vec3 ic = reflect(f.oc, p.coatGgx.sampleVisibleNormal(f.oc, u));
+    if (!(ic.z > 0.0f)) return false;  // under the coat's horizon: absorbed, as the base's lobes
+    wi = f.coat.toWorld(ic);
   } else if (uLobe < (edge += lobes.sheen)) {
     const Vec3 d = sampleCosineHemisphere(u);
     // Uniform in the hemisphere: the cosine-weighted direction's polar angle remapped,

@@ -11,6 +11,8 @@
 //   sheen layer    = sheenColor f_charlie + material * min(1 - max3(sheenColor) E(n.v),
 //                                                          1 - max3(sheenColor) E(n.l))
 //                    (KHR_materials_sheen; materials/sheen.h)
+//   Fr, F_metal    = mix(schlick, F_thin_film, iridescence)   (KHR_materials_iridescence;
+//                    materials/iridescence.h)
 //   coated         = mix(sheen layer, clearcoat_brdf, clearcoat * schlick(0.04, n_c.v))
 //                    (KHR_materials_clearcoat: a GGX lobe of its own roughness about its own normal
 //                    n_c, the geometry's normal or its own normal map)
@@ -47,6 +49,10 @@ struct GltfPbrInputs {
   // own tangent-space normal map (null: the geometry's interpolated normal, unmapped).
   std::shared_ptr<const Texture> clearcoat, clearcoatRoughness, clearcoatNormal;
   float clearcoatNormalScale = 1.0f;
+  // KHR_materials_iridescence: .r = the film's weight (null = no film); the thickness texture's .r
+  // blends between the minimum and maximum thickness (nm; null = the maximum); the film's ior.
+  std::shared_ptr<const Texture> iridescence, iridescenceThickness;
+  float iridescenceIor = 1.3f, iridescenceThicknessMin = 100.0f, iridescenceThicknessMax = 400.0f;
   float ior = 1.5f;  // 0: the dielectric reflects totally (f0 = 1), as KHR_materials_ior allows
   // KHR_materials_transmission without KHR_materials_volume is thin-walled: light passes through
   // the surface without bending. With a volume (thicknessFactor > 0) the surface is a refracting
@@ -91,7 +97,8 @@ class GltfPbrMaterial final : public Material {
     float sheenRoughness = 0.0f;
     float clearcoat = 0.0f;
     Ggx coatGgx = Ggx::fromRoughness(0.0f);
-    Vec3 coatNormal{0.0f};  // world space, on the side of hit.ng
+    Vec3 coatNormal{0.0f};                           // world space, on the side of hit.ng
+    float iridescence = 0.0f, filmThickness = 0.0f;  // nm
   };
   // Probabilities with which sample() picks its lobes (they sum to 1).
   struct LobeProbabilities {
@@ -115,6 +122,9 @@ class GltfPbrMaterial final : public Material {
   // Fresnel reflectance of the dielectric layer for the cosine between wo and the microfacet
   // normal, before the specular weight.
   Color dielectricFresnel(const Params& p, float cosOH, bool outside) const;
+  // The reflectances at cos(v, h) of the dielectric (before the specular weight) and of the metal,
+  // with the thin film of KHR_materials_iridescence mixed in where there is one.
+  void reflectances(const Params& p, float cosOH, bool outside, Color& dielectric, Color& metal) const;
   // The clearcoat's Fresnel weight, clearcoat x schlick(0.04, n_c.v).
   float coatWeight(const Params& p, const Frames& f) const;
   // f |cos theta_i| of the base (Appendix B with specular and transmission) and the mixture pdf of
@@ -128,11 +138,11 @@ class GltfPbrMaterial final : public Material {
   Color evalAndPdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi, float& pdf) const;
 
   GltfPbrInputs inputs_;
-  float ior_;      // max(ior, 1)
-  float f0_;       // ((ior - 1) / (ior + 1))^2, the dielectric's normal-incidence reflectance
-  bool sheen_, coat_;  // the layers are present
-  bool refracts_;  // a volumetric (bending) transmission lobe: !thinWalled and ior_ > 1
-  uint64_t id_;    // fetchFor's memo key: newHitMemoOwner()
+  float ior_;                 // max(ior, 1)
+  float f0_;                  // ((ior - 1) / (ior + 1))^2, the dielectric's normal-incidence reflectance
+  bool sheen_, coat_, film_;  // the layers are present
+  bool refracts_;             // a volumetric (bending) transmission lobe: !thinWalled and ior_ > 1
+  uint64_t id_;               // fetchFor's memo key: newHitMemoOwner()
 };
 
 }  // namespace ember

@@ -36,8 +36,8 @@ struct AlbedoTable {
   std::array<float, kCosSteps * kRoughnessSteps> values;
   AlbedoTable() {
     for (int r = 0; r < kRoughnessSteps; ++r) {
-      const float roughness =
-          CharlieSheen::kMinRoughness + (1.0f - CharlieSheen::kMinRoughness) * float(r) / float(kRoughnessSteps - 1);
+      const float roughness = CharlieSheen::kMinRoughness +
+                              (1.0f - CharlieSheen::kMinRoughness) * float(r) / float(kRoughnessSteps - 1);
       for (int c = 0; c < kCosSteps; ++c)
         values[size_t(r * kCosSteps + c)] = float(sheenAlbedoQuadrature(
             float(c * c) / float((kCosSteps - 1) * (kCosSteps - 1)), roughness, kQuadrature));
@@ -51,7 +51,8 @@ float sheenAlbedo(float cosTheta, float sheenRoughness) {
   static const AlbedoTable table;  // thread-safe initialisation; built by the first sheen material
   const float x = std::sqrt(std::clamp(std::abs(cosTheta), 0.0f, 1.0f)) * float(kCosSteps - 1);
   const float r = std::clamp(sheenRoughness, CharlieSheen::kMinRoughness, 1.0f);
-  const float y = (r - CharlieSheen::kMinRoughness) / (1.0f - CharlieSheen::kMinRoughness) * float(kRoughnessSteps - 1);
+  const float y =
+      (r - CharlieSheen::kMinRoughness) / (1.0f - CharlieSheen::kMinRoughness) * float(kRoughnessSteps - 1);
   const int x0 = std::min(int(x), kCosSteps - 2), y0 = std::min(int(y), kRoughnessSteps - 2);
   const float fx = x - float(x0), fy = y - float(y0);
   const auto at = [&](int xi, int yi) { return table.values[size_t(yi * kCosSteps + xi)]; };

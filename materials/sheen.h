@@ -56,8 +56,9 @@ struct CharlieSheen {
   // at alpha = 0 and 1.
   float fit(float x) const {
     const float t = (1.0f - alpha) * (1.0f - alpha);
-    const float a = lerp(21.5473f, 25.3245f, t), b = lerp(3.82987f, 3.32435f, t), c = lerp(0.19823f, 0.16801f, t),
-                d = lerp(-1.97760f, -1.27393f, t), e = lerp(-4.32054f, -4.85967f, t);
+    const float a = lerp(21.5473f, 25.3245f, t), b = lerp(3.82987f, 3.32435f, t),
+                c = lerp(0.19823f, 0.16801f, t), d = lerp(-1.97760f, -1.27393f, t),
+                e = lerp(-4.32054f, -4.85967f, t);
     return a / (1.0f + b * std::pow(x, c)) + d * x + e;
   }
   static float lerp(float a, float b, float t) { return a + (b - a) * t; }
@@ -72,6 +73,5 @@ float sheenAlbedo(float cosTheta, float sheenRoughness);
 // The same integral by direct quadrature (n x 2n points over the hemisphere, dense towards the
 // horizon): what the table is built from, and what tests check it against at finer n.
 double sheenAlbedoQuadrature(float cosTheta, float sheenRoughness, int n);
-
 
 }  // namespace ember

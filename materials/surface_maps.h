@@ -23,7 +23,8 @@ struct SurfaceMaps {
   // set): the texel's XYZ = 2 RGB - 1, X and Y scaled by `scale`, in the frame (T, B, N) with
   // B = cross(N, T) w (glTF 2.0 section 3.9.3). Falls back to `n` where the tangent is unusable.
   // The clearcoat layer's own normal map (KHR_materials_clearcoat) is read the same way.
-  static Vec3 perturbNormal(const Texture& map, float scale, const Vec3& n, const glm::vec4& tangent, Vec2 uv) {
+  static Vec3 perturbNormal(const Texture& map, float scale, const Vec3& n, const glm::vec4& tangent,
+                            Vec2 uv) {
     const Color c = map.eval(uv);
     const Vec3 local((2.0f * c.x - 1.0f) * scale, (2.0f * c.y - 1.0f) * scale, 2.0f * c.z - 1.0f);
     Vec3 t = Vec3(tangent) - n * glm::dot(n, Vec3(tangent));

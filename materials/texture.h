@@ -144,7 +144,9 @@ class VertexColorTexture final : public Texture {
  public:
   explicit VertexColorTexture(std::shared_ptr<const Texture> inner) : inner_(std::move(inner)) {}
   Color eval(Vec2 uv) const override { return inner_->eval(uv); }
-  Color evalAt(const SurfaceHit& hit) const override { return inner_->evalAt(hit) * Color(hit.vertexColor()); }
+  Color evalAt(const SurfaceHit& hit) const override {
+    return inner_->evalAt(hit) * Color(hit.vertexColor());
+  }
   Color maxValue() const override { return inner_->maxValue(); }
   Color average() const override { return inner_->average(); }
   bool mayBeBlack() const override { return true; }

@@ -200,7 +200,7 @@ void samplePointLight(const PointLight& light, const uint64_t* keys, size_t n, N
     while (end < queries && (wave.queryKey[end] >> 16) == (wave.queryKey[first] >> 16)) ++end;
     if (const auto* area = dynamic_cast<const AreaLight*>(light)) {
       sampleAreaLight(*area, &wave.queryKey[first], end - first, wave.nee, wave.lightU.data());
-    } else if (const auto* point = dynamic_cast<const PointLight*>(light)) {
+    } else if (const auto* point = dynamic_cast<const PointLight*>(light); point && !point->ranged()) {
       samplePointLight(*point, &wave.queryKey[first], end - first, wave.nee);
     } else {
       for (size_t q = first; q < end; ++q) {

@@ -24,16 +24,19 @@ static bool samplePosition(const Vec3& position, const Vec3& ref, const Color& i
 }
 
 bool PointLight::sample(const Vec3& ref, Vec2, LightSample& out) const {
-  return samplePosition(position_, ref, intensity_, out);
+  if (!samplePosition(position_, ref, intensity_, out)) return false;
+  if (range_ > 0.0f) out.Li *= rangeWindow(out.dist, range_);
+  return true;
 }
 
 SpotLight::SpotLight(const Vec3& position, const Vec3& direction, const Color& intensity, float innerRad,
-                     float outerRad)
+                     float outerRad, float range)
     : position_(position),
       direction_(glm::normalize(direction)),
       intensity_(intensity),
       cosInner_(std::cos(innerRad)),
-      cosOuter_(std::cos(outerRad)) {}
+      cosOuter_(std::cos(outerRad)),
+      range_(range) {}
 
 float SpotLight::falloff(float cosAngle) const {
   // KHR_lights_punctual's recommended implementation, including its guard against inner == outer.
@@ -44,7 +47,7 @@ float SpotLight::falloff(float cosAngle) const {
 
 bool SpotLight::sample(const Vec3& ref, Vec2, LightSample& out) const {
   if (!samplePosition(position_, ref, intensity_, out)) return false;
-  out.Li *= falloff(glm::dot(-out.wi, direction_));
+  out.Li *= falloff(glm::dot(-out.wi, direction_)) * rangeWindow(out.dist, range_);
   return true;
 }
 

@@ -52,19 +52,32 @@ class Light {
   bool causticTraced = false;
 };
 
+// KHR_lights_punctual's range window of a point or spot light, the recommended implementation of
+// its "Range Property": max(min(1 - (d / range)^4, 1), 0) multiplies the inverse-square falloff,
+// so that the light reaches exactly nothing past `range`. A range of 0 means infinite (no window).
+inline float rangeWindow(float distance, float range) {
+  if (!(range > 0.0f)) return 1.0f;
+  const float r = distance / range, r2 = r * r;
+  return std::clamp(1.0f - r2 * r2, 0.0f, 1.0f);
+}
+
 class PointLight final : public Light {
  public:
-  PointLight(const Vec3& position, const Color& intensity) : position_(position), intensity_(intensity) {}
+  PointLight(const Vec3& position, const Color& intensity, float range = 0.0f)
+      : position_(position), intensity_(intensity), range_(range) {}
   bool sample(const Vec3& ref, Vec2 u, LightSample& out) const override;
   float pdf(const Vec3&, const Vec3&, const Vec3&) const override { return 0.0f; }
   Color power(float) const override { return 4.0f * kPi * intensity_; }
   bool isDelta() const override { return true; }
   const Vec3& position() const { return position_; }
   const Color& intensity() const { return intensity_; }
+  // A finite range (rangeWindow): the next-event kernel's whole-vector rows assume none.
+  bool ranged() const { return range_ > 0.0f; }
 
  private:
   Vec3 position_;
   Color intensity_;
+  float range_;  // 0: infinite
 };
 
 // A spot light (glTF KHR_lights_punctual): intensity I [W/sr] along `direction`, fading between
@@ -73,7 +86,7 @@ class PointLight final : public Light {
 class SpotLight final : public Light {
  public:
   SpotLight(const Vec3& position, const Vec3& direction, const Color& intensity, float innerRad,
-            float outerRad);
+            float outerRad, float range = 0.0f);
   bool sample(const Vec3& ref, Vec2 u, LightSample& out) const override;
   float pdf(const Vec3&, const Vec3&, const Vec3&) const override { return 0.0f; }
   // Bounded by the power inside the outer cone.
@@ -85,6 +98,7 @@ class SpotLight final : public Light {
   Vec3 position_, direction_;
   Color intensity_;
   float cosInner_, cosOuter_;
+  float range_;  // 0: infinite (rangeWindow)
 };
 
 // A directional light (the sun): irradiance E [W/m^2] on a surface facing it, arriving from the

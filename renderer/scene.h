@@ -68,6 +68,8 @@ class Scene {
   float environmentRotateYDeg = 0.0f;
   std::vector<std::unique_ptr<Material>> materials;
   std::vector<std::string> materialNames;  // parallel to materials
+  // The KHR_materials_variants names of the glTF files loaded (`ember info` lists them).
+  std::vector<std::string> materialVariants;
   std::vector<ShapeEntry> shapes;
   std::vector<MeshEntry> meshes;
   std::vector<std::unique_ptr<Light>> lights;  // point lights; build() appends the derived ones

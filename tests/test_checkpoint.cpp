@@ -136,7 +136,7 @@ Checkpoint sampleCheckpoint() {
   const Scene scene = smallScene(12);
   const auto integrator = makeIntegrator(scene.settings, Kernel::Wavefront);
   Checkpoint c;
-  c.identity = identityOf(scene, test::sourcePath("scenes/cornell-area.json"), -1, "");
+  c.identity = identityOf(scene, test::sourcePath("scenes/cornell-area.json"), -1, "", "");
   c.spp = 8;
   c.passSpp = 2;
   c.passes = 2;

@@ -96,7 +96,7 @@ namespace {
 // Parameters of the test as a whole.
 
 constexpr double kAlpha = 0.01;     // family-wise significance level over every case in the file
-constexpr int kNumCases = 76;       // m for the Sidak correction: must equal allCases().size()
+constexpr int kNumCases = 77;       // m for the Sidak correction: must equal allCases().size()
 constexpr long kSamples = 1000000;  // samples per case
 constexpr double kMinExpected = 5.0;
 // Absolute error allowed on integrals of the pdf over the sphere: the midpoint rule on the
@@ -448,8 +448,10 @@ std::shared_ptr<const Texture> constant(const Color& c) {
 
 // Material sampling: the non-delta samples must follow pdf(wo, wi); delta samples and absorbed
 // paths count as failed (pdf integrates to the probability of a non-delta, non-absorbed sample).
-void runMaterial(std::shared_ptr<const Material> m, Vec3 wo, uint64_t seed, bool wrongPdf = false) {
-  const SurfaceHit hit = flatHit();
+void runMaterial(std::shared_ptr<const Material> m, Vec3 wo, uint64_t seed, bool wrongPdf = false,
+                 const VertexAttributes* attributes = nullptr) {
+  SurfaceHit hit = flatHit();
+  hit.attributes = attributes;
   wo = glm::normalize(wo);
   long inconsistent = 0;
   DirectionalCase c;
@@ -954,22 +956,78 @@ const std::vector<Chi2Case>& allCases() {
       Vec3 wo;
     };
     const LayeredCase layeredCases[] = {
-        {"GltfSpecular_colour2_w0p6_r0p3_woOblique", 0.3f, 0.0f, 0.0f, true, {Color(2.0f, 1.0f, 0.5f), 0.6f},
+        {"GltfSpecular_colour2_w0p6_r0p3_woOblique",
+         0.3f,
+         0.0f,
+         0.0f,
+         true,
+         {Color(2.0f, 1.0f, 0.5f), 0.6f},
          woOblique},
-        {"GltfSheen_r0p5_woNormal", 0.6f, 0.0f, 0.0f, true, {Color(1.0f), 1.0f, Color(0.9f, 0.5f, 0.3f), 0.5f},
+        {"GltfSheen_r0p5_woNormal",
+         0.6f,
+         0.0f,
+         0.0f,
+         true,
+         {Color(1.0f), 1.0f, Color(0.9f, 0.5f, 0.3f), 0.5f},
          woNormal},
-        {"GltfSheen_r0p2_woGrazing", 0.6f, 0.0f, 0.0f, true, {Color(1.0f), 1.0f, Color(1.0f), 0.2f}, woGrazing},
-        {"GltfCoat_c1_r0p05_over_r0p6_woOblique", 0.6f, 0.0f, 0.0f, true,
-         {Color(1.0f), 1.0f, Color(0.0f), 0.5f, 1.0f, 0.05f}, woOblique},
-        {"GltfCoat_c0p5_r0p4_over_metal_woGrazing", 0.3f, 1.0f, 0.0f, true,
-         {Color(1.0f), 1.0f, Color(0.0f), 0.5f, 0.5f, 0.4f}, woGrazing},
-        {"GltfLayers_all_thin_t0p5_woBelow", 0.4f, 0.2f, 0.5f, true,
-         {Color(1.5f, 1.0f, 1.0f), 0.8f, Color(0.5f), 0.4f, 0.7f, 0.2f}, woBelow},
-        {"GltfLayers_all_volume_t0p7_woOblique", 0.3f, 0.0f, 0.7f, false,
-         {Color(1.0f), 0.9f, Color(0.6f), 0.6f, 0.8f, 0.1f}, woOblique},
-        {"GltfLayers_all_volume_t0p7_woBelowInside", 0.3f, 0.0f, 0.7f, false,
-         {Color(1.0f), 0.9f, Color(0.6f), 0.6f, 0.8f, 0.1f}, woBelow},
+        {"GltfSheen_r0p2_woGrazing",
+         0.6f,
+         0.0f,
+         0.0f,
+         true,
+         {Color(1.0f), 1.0f, Color(1.0f), 0.2f},
+         woGrazing},
+        {"GltfCoat_c1_r0p05_over_r0p6_woOblique",
+         0.6f,
+         0.0f,
+         0.0f,
+         true,
+         {Color(1.0f), 1.0f, Color(0.0f), 0.5f, 1.0f, 0.05f},
+         woOblique},
+        {"GltfCoat_c0p5_r0p4_over_metal_woGrazing",
+         0.3f,
+         1.0f,
+         0.0f,
+         true,
+         {Color(1.0f), 1.0f, Color(0.0f), 0.5f, 0.5f, 0.4f},
+         woGrazing},
+        {"GltfLayers_all_thin_t0p5_woBelow",
+         0.4f,
+         0.2f,
+         0.5f,
+         true,
+         {Color(1.5f, 1.0f, 1.0f), 0.8f, Color(0.5f), 0.4f, 0.7f, 0.2f},
+         woBelow},
+        {"GltfLayers_all_volume_t0p7_woOblique",
+         0.3f,
+         0.0f,
+         0.7f,
+         false,
+         {Color(1.0f), 0.9f, Color(0.6f), 0.6f, 0.8f, 0.1f},
+         woOblique},
+        {"GltfLayers_all_volume_t0p7_woBelowInside",
+         0.3f,
+         0.0f,
+         0.7f,
+         false,
+         {Color(1.0f), 0.9f, Color(0.6f), 0.6f, 0.8f, 0.1f},
+         woBelow},
     };
+    // A coat whose normal (a mesh's interpolated normal: the hit's attributes) tilts 35 degrees
+    // from the base's: its samples reach under the base's horizon and under its own.
+    struct TiltedNormal final : VertexAttributes {
+      Vec2 texCoordAt(int, uint32_t, Vec2 b) const override { return b; }
+      glm::vec4 colorAt(uint32_t, Vec2) const override { return glm::vec4(1.0f); }
+      Vec3 normalAt(uint32_t, Vec2) const override { return glm::normalize(Vec3(0.7f, 0.0f, 1.0f)); }
+      glm::vec4 tangentAt(uint32_t, Vec2) const override { return glm::vec4(0.0f); }
+    };
+    static const TiltedNormal tilted;
+    add("GltfCoat_tilted_c1_r0p3_woGrazing", [=](uint64_t s) {
+      Layers l;
+      l.coat = 1.0f;
+      l.coatRoughness = 0.3f;
+      runMaterial(layered(0.5f, 0.0f, 0.0f, true, l), Vec3(-0.3f, 0.1f, 0.5f), s, false, &tilted);
+    });
     for (const LayeredCase& lc : layeredCases) {
       add(lc.name, [=](uint64_t s) {
         runMaterial(layered(lc.roughness, lc.metallic, lc.transmission, lc.thinWalled, lc.layers), lc.wo, s);

@@ -87,8 +87,8 @@ TEST(GltfEmission, DefaultSkyUnlessTheFileHasLightGivingEmission) {
     EXPECT_EQ(scene.environment() != nullptr, sky) << path;
   }
   const auto render = [&](const std::string& path, const std::string& extra) {
-    return test::runEmber("render '" + path + "' -o '" + dir.file("a.exr") + "' --spp 1 --width 8 --height 8 -q " +
-                          extra);
+    return test::runEmber("render '" + path + "' -o '" + dir.file("a.exr") +
+                          "' --spp 1 --width 8 --height 8 -q " + extra);
   };
   auto r = render(lit, "");
   EXPECT_EQ(r.exitCode, 0) << r.output;

@@ -2,8 +2,9 @@
 //
 //  - pointwise, against formulas written here from the extension texts and papers in double
 //    precision, sharing no code with the material: KHR_materials_specular's fresnel_mix, the
-//    Charlie sheen of KHR_materials_sheen (Estevez & Kulla 2017) with its albedo scaling, and
-//    KHR_materials_clearcoat's fresnel_coat over the base;
+//    Charlie sheen of KHR_materials_sheen (Estevez & Kulla 2017) with its albedo scaling,
+//    KHR_materials_clearcoat's fresnel_coat over the base, and KHR_materials_iridescence's thin
+//    film (Belcour & Barla 2017) in the dielectric's and the metal's Fresnel;
 //  - the sheen's directional albedo table against a finer quadrature of the definition;
 //  - energy: white layers over a white diffuse base reflect at most what they receive (the
 //    albedo scaling's purpose), measured by the Monte Carlo mean of sample() weights;
@@ -15,6 +16,7 @@
 
 #include "core/rng.h"
 #include "materials/gltf_pbr.h"
+#include "materials/iridescence.h"
 #include "materials/sheen.h"
 #include "materials/texture.h"
 
@@ -33,7 +35,9 @@ namespace {
 
 constexpr double kPiD = std::numbers::pi;
 
-std::shared_ptr<const Texture> constant(const Color& c) { return std::make_shared<ConstantTexture>(c); }
+std::shared_ptr<const Texture> constant(const Color& c) {
+  return std::make_shared<ConstantTexture>(c);
+}
 
 struct Layers {
   Color base{0.5f, 0.4f, 0.3f};
@@ -43,6 +47,7 @@ struct Layers {
   Color sheen{0.0f};
   float sheenRoughness = 0.5f;
   float coat = 0.0f, coatRoughness = 0.2f;
+  float iridescence = 0.0f, filmIor = 1.3f, filmThickness = 400.0f;
 };
 
 std::shared_ptr<GltfPbrMaterial> make(const Layers& l) {
@@ -59,6 +64,11 @@ std::shared_ptr<GltfPbrMaterial> make(const Layers& l) {
     in.clearcoat = constant(Color(l.coat));
     in.clearcoatRoughness = constant(Color(l.coatRoughness));
   }
+  if (l.iridescence > 0.0f) {
+    in.iridescence = constant(Color(l.iridescence));
+    in.iridescenceIor = l.filmIor;
+    in.iridescenceThicknessMax = l.filmThickness;
+  }
   return std::make_shared<GltfPbrMaterial>(std::move(in));
 }
 
@@ -66,7 +76,9 @@ std::shared_ptr<GltfPbrMaterial> make(const Layers& l) {
 
 using D3 = glm::dvec3;
 
-double schlick(double f0, double cosTheta) { return f0 + (1.0 - f0) * std::pow(1.0 - std::abs(cosTheta), 5.0); }
+double schlick(double f0, double cosTheta) {
+  return f0 + (1.0 - f0) * std::pow(1.0 - std::abs(cosTheta), 5.0);
+}
 
 // glTF 2.0 Appendix B.3.2: D_GGX and V_GGX (the height-correlated Smith visibility).
 double ggxD(double nh, double alpha) {
@@ -116,7 +128,49 @@ double sheenAlbedoDefinition(double mu, double roughness, int n) {
   return sum * 2.0 * kPiD / (double(n) * 2.0 * n);
 }
 
-// The whole layered definition, f cos(theta_l), for an opaque dielectric or metal with all three
+// KHR_materials_iridescence's implementation notes (Belcour & Barla 2017): the thin-film
+// reflectance, written from the extension's pseudo-code in double precision, with the optical path
+// difference inside the film (cos theta_2, as Belcour & Barla's own code has it).
+glm::dvec3 thinFilm(double n1, double n2Film, double cos1, double d, const glm::dvec3& f0) {
+  const double t = std::clamp(d / 30.0, 0.0, 1.0);
+  const double n2 = n1 + (n2Film - n1) * t * t * (3.0 - 2.0 * t);  // the sample viewer's fade to no film
+  const double sin2 = (n1 / n2) * (n1 / n2) * (1.0 - cos1 * cos1);
+  if (sin2 >= 1.0) return glm::dvec3(1.0);
+  const double cos2 = std::sqrt(1.0 - sin2);
+  const auto f0Of = [](double nt, double ni) { return (nt - ni) * (nt - ni) / ((nt + ni) * (nt + ni)); };
+  const double r12 = schlick(f0Of(n2, n1), cos1), t121 = 1.0 - r12;
+  glm::dvec3 n3, r23, phi;
+  for (int k = 0; k < 3; ++k) {
+    const double s = std::sqrt(std::min(f0[k] + 1e-4, 0.9999));
+    n3[k] = (1.0 + s) / (1.0 - s);
+    r23[k] = schlick(f0Of(n3[k], n2), cos2);
+    phi[k] = (n2 < n1 ? 0.0 : kPiD) + (n3[k] < n2 ? kPiD : 0.0);
+  }
+  const double opd = 2.0 * n2 * d * cos2;
+  const glm::dvec3 r123 = glm::clamp(r12 * r23, 1e-5, 0.9999);
+  const glm::dvec3 rs = t121 * t121 * r23 / (1.0 - r123);
+  glm::dvec3 I = r12 + rs, cm = rs - t121;
+  for (int m = 1; m <= 2; ++m) {
+    cm *= glm::sqrt(r123);
+    const double phase = 2.0 * kPiD * m * opd * 1e-9;
+    const double val[3] = {5.4856e-13, 4.4201e-13, 5.2481e-13}, pos[3] = {1.6810e+06, 1.7953e+06, 2.2084e+06},
+                 var[3] = {4.3278e+09, 9.3046e+09, 6.6121e+09};
+    glm::dvec3 xyz;
+    for (int k = 0; k < 3; ++k)
+      xyz[k] = val[k] * std::sqrt(2.0 * kPiD * var[k]) * std::cos(pos[k] * phase + m * phi[k]) *
+               std::exp(-phase * phase * var[k]);
+    xyz.x += 9.7470e-14 * std::sqrt(2.0 * kPiD * 4.5282e+09) * std::cos(2.2399e+06 * phase + m * phi[0]) *
+             std::exp(-4.5282e+09 * phase * phase);
+    xyz /= 1.0685e-7;
+    const glm::dvec3 rgb(3.2404542 * xyz.x - 1.5371385 * xyz.y - 0.4985314 * xyz.z,
+                         -0.9692660 * xyz.x + 1.8760108 * xyz.y + 0.0415560 * xyz.z,
+                         0.0556434 * xyz.x - 0.2040259 * xyz.y + 1.0572252 * xyz.z);
+    I += cm * 2.0 * rgb;
+  }
+  return glm::clamp(I, glm::dvec3(0.0), glm::dvec3(1.0));  // Ember's clamp at 1 (iridescence.h)
+}
+
+// The whole layered definition, f cos(theta_l), for an opaque dielectric or metal with all four
 // extensions (gltf_pbr.h's formulas; each from its extension text).
 glm::dvec3 definition(const Layers& L, const D3& v, const D3& l) {
   if (!(v.z > 0.0) || !(l.z > 0.0)) return glm::dvec3(0.0);
@@ -127,12 +181,19 @@ glm::dvec3 definition(const Layers& L, const D3& v, const D3& l) {
   const glm::dvec3 base(L.base);
   // KHR_materials_specular: f0 = min(0.04 specularColor, 1), fresnel_mix with weight w.
   glm::dvec3 fr;
-  for (int k = 0; k < 3; ++k) fr[k] = schlick(std::min(0.04 * L.specularColor[k], 1.0), vh);
+  glm::dvec3 f0d;
+  for (int k = 0; k < 3; ++k) f0d[k] = std::min(0.04 * L.specularColor[k], 1.0);
+  for (int k = 0; k < 3; ++k) fr[k] = schlick(f0d[k], vh);
+  const double outsideIor = L.coat > 0.0f ? 1.5 : 1.0;
+  if (L.iridescence > 0.0f)
+    fr = glm::mix(fr, thinFilm(outsideIor, L.filmIor, vh, L.filmThickness, f0d), double(L.iridescence));
   const double w = L.specular;
   const double frMax = std::max(fr.x, std::max(fr.y, fr.z));
   const glm::dvec3 dielectric = (1.0 - w * frMax) * base / kPiD + w * fr * spec;
   glm::dvec3 fm;
   for (int k = 0; k < 3; ++k) fm[k] = schlick(base[k], vh);
+  if (L.iridescence > 0.0f)
+    fm = glm::mix(fm, thinFilm(outsideIor, L.filmIor, vh, L.filmThickness, base), double(L.iridescence));
   glm::dvec3 f = (1.0 - L.metallic) * dielectric + double(L.metallic) * fm * spec;
   // KHR_materials_sheen with albedo scaling.
   if (!isBlack(L.sheen)) {
@@ -184,14 +245,23 @@ TEST(GltfLayers, MatchTheKhronosDefinitionsPointwise) {
   Layers coat;
   coat.coat = 0.8f;
   coat.coatRoughness = 0.15f;
+  Layers film;
+  film.roughness = 0.3f;
+  film.iridescence = 0.8f;
+  film.filmThickness = 450.0f;
+  Layers filmMetal = film;
+  filmMetal.metallic = 0.7f;
+  filmMetal.filmIor = 1.8f;
   Layers all = sheen;
   all.metallic = 0.3f;
   all.specular = 0.7f;
   all.specularColor = Color(1.2f, 1.0f, 0.8f);
   all.coat = 0.6f;
   all.coatRoughness = 0.3f;
-  for (const Case& c : {Case{"specular", specular, 2e-4}, Case{"sheen", sheen, 1e-2}, Case{"coat", coat, 2e-4},
-                        Case{"all", all, 1e-2}}) {
+  all.iridescence = 0.5f;
+  for (const Case& c :
+       {Case{"specular", specular, 2e-4}, Case{"sheen", sheen, 1e-2}, Case{"coat", coat, 2e-4},
+        Case{"iridescence", film, 2e-4}, Case{"iridescent metal", filmMetal, 2e-4}, Case{"all", all, 1e-2}}) {
     const auto m = make(c.layers);
     Rng rng(7, 3);
     for (int k = 0; k < 200; ++k) {
@@ -229,7 +299,8 @@ TEST(GltfLayers, LayersOverAWhiteBaseConserveEnergy) {
   coat.coatRoughness = 0.3f;
   Layers both = sheen;
   both.coat = 1.0f;
-  for (const auto& [name, layers] : {std::pair{"sheen", sheen}, std::pair{"coat", coat}, std::pair{"both", both}}) {
+  for (const auto& [name, layers] :
+       {std::pair{"sheen", sheen}, std::pair{"coat", coat}, std::pair{"both", both}}) {
     const auto m = make(layers);
     for (float mu : {0.15f, 0.5f, 0.95f}) {
       const Vec3 wo(std::sqrt(1.0f - mu * mu), 0.0f, mu);
@@ -244,6 +315,25 @@ TEST(GltfLayers, LayersOverAWhiteBaseConserveEnergy) {
       EXPECT_GT(albedo.mean(), 0.85) << name << " at cos " << mu << ": the layers should lose little";
     }
   }
+}
+
+// The thin film's limits: a film thinning to nothing is nearly no film (Schlick's reflectance of
+// the base alone, within 0.04: the approximation's first interface keeps Schlick's (1 - cos)^5
+// even when index-matched, and its interference terms scale with the root of that), and a
+// reflectance stays in [0, 1].
+TEST(GltfLayers, ThinFilmLimits) {
+  for (float cos : {0.7f, 0.9f, 1.0f})
+    for (const Color& f0 : {Color(0.04f), Color(0.9f, 0.6f, 0.3f)}) {
+      const Color none = thinFilmFresnel(1.0f, 1.3f, cos, 0.0f, f0);
+      for (int k = 0; k < 3; ++k) EXPECT_NEAR(none[k], schlickFresnel(f0[k], cos), 0.04f) << cos << " " << k;
+      for (float d : {50.0f, 250.0f, 500.0f, 1200.0f}) {
+        const Color f = thinFilmFresnel(1.0f, 1.5f, cos, d, f0);
+        for (int k = 0; k < 3; ++k) {
+          EXPECT_GE(f[k], 0.0f);
+          EXPECT_LE(f[k], 1.0f + 1e-3f) << "cos " << cos << ", thickness " << d;
+        }
+      }
+    }
 }
 
 // f(wo, wi) = f(wi, wo) for the specular and sheen layers (their scaling is symmetric by the min).

@@ -7,6 +7,8 @@
 #include "renderer/path_integrator.h"
 #include "renderer/render.h"
 
+#include "packet/wavefront_integrator.h"
+
 #include <gtest/gtest.h>
 #include <tiny_gltf.h>
 
@@ -80,8 +82,9 @@ std::string writeGltf(const TempDir& dir, const tinygltf::Light& light,
   return path;
 }
 
-// Radiance seen straight down at `target` on the plane (direct light only).
-float renderAt(const TempDir& dir, const std::string& gltf, const Vec3& target) {
+// Radiance seen straight down at `target` on the plane (direct light only), by the reference
+// integrator or, with `lanes`, by the kernel `ember render` uses by default.
+float renderAt(const TempDir& dir, const std::string& gltf, const Vec3& target, bool lanes = false) {
   const std::string json = R"({"image": {"width": 1, "height": 1},
     "camera": {"origin": [)" +
                            std::to_string(target.x) + ", 1, " + std::to_string(target.z) +
@@ -94,11 +97,12 @@ float renderAt(const TempDir& dir, const std::string& gltf, const Vec3& target) 
                            gltf + R"(", "materials": {"plane": "grey"}}]})";
   Scene scene = loadScene(dir.write("s.json", json));
   scene.build();
-  const PathIntegrator integrator(2, 5);
+  const PathIntegrator reference(2, 5);
+  const std::unique_ptr<Integrator> kernel = makeIntegrator(scene.settings, Kernel::Lanes);
   Film film(1, 1);
   RenderOptions options;
   options.spp = 16;
-  render(scene, integrator, options, film);
+  render(scene, lanes ? *kernel : static_cast<const Integrator&>(reference), options, film);
   return film.mean().at(0, 0).x;
 }
 
@@ -113,6 +117,28 @@ TEST(GltfLights, PointLightInCandelaMatchesTheInverseSquareLaw) {
   const float r2 = glm::dot(l - p, l - p);
   const float expected = kAlbedo / kPi * 2.0f * (l.y / std::sqrt(r2)) / r2;
   EXPECT_NEAR(renderAt(dir, gltf, p), expected, 2e-4f * expected);
+}
+
+// KHR_lights_punctual's range: the inverse-square law times the recommended window
+// max(min(1 - (d / range)^4, 1), 0), exactly nothing at and past the range; in the reference
+// integrator and in the default kernel (which samples ranged point lights one by one).
+TEST(GltfLights, PointLightRangeFollowsTheRecommendedWindow) {
+  TempDir dir;
+  tinygltf::Light light;
+  light.type = "point";
+  light.intensity = 683.0 * 2.0;  // 2 W/sr
+  light.range = 3.0;
+  const std::string gltf = writeGltf(dir, light, {0.5, 2.0, -0.3}, {});
+  const Vec3 l(0.5f, 2.0f, -0.3f);
+  for (float x : {0.0f, 1.5f, 2.4f, 3.0f}) {
+    const Vec3 p(x, 0.0f, 0.0f);
+    const float r2 = glm::dot(l - p, l - p), d = std::sqrt(r2);
+    const float window = std::clamp(1.0f - std::pow(d / 3.0f, 4.0f), 0.0f, 1.0f);
+    const float expected = kAlbedo / kPi * 2.0f * (l.y / d) / r2 * window;
+    for (const bool lanes : {false, true})
+      EXPECT_NEAR(renderAt(dir, gltf, p, lanes), expected, 2e-4f * expected + 1e-7f)
+          << "x = " << x << (lanes ? ", lanes kernel" : ", reference");
+  }
 }
 
 TEST(GltfLights, SpotLightFollowsTheSpecFalloff) {

@@ -389,7 +389,8 @@ TEST(GltfExtensions, UnsupportedRequiredExtensionIsAnErrorAndAnUsedOneAWarning) 
       << r.output;
   EXPECT_FALSE(std::filesystem::exists(dir.file("a.exr")));
 
-  const std::string used = twoCameraFile(dir, {}, {"KHR_materials_diffuse_transmission", "KHR_materials_ior"});
+  const std::string used =
+      twoCameraFile(dir, {}, {"KHR_materials_diffuse_transmission", "KHR_materials_ior"});
   r = test::runEmber("render '" + used + "' --spp 1 --width 8 --height 8 -q -o " + dir.file("b.exr"));
   EXPECT_EQ(r.exitCode, 0) << r.output;
   EXPECT_NE(r.output.find("ignoring unsupported glTF extensions: KHR_materials_diffuse_transmission\n"),
@@ -432,7 +433,8 @@ TEST(GltfAttributes, UnlitTexCoord1AndVertexColours) {
   ASSERT_TRUE(scene.intersect(Ray{Vec3(0.1f, 0.2f, 3.0f), Vec3(0.0f, 0.0f, -1.0f)}, hit));
   const Color want(0.5f, 0.5f, 0.25f);  // factor (0.5, 1, 1) x white x COLOR_0 (1, 0.5, 0.25)
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(hit.emission[c], want[c], 1e-6f) << c;
-  EXPECT_EQ(hit.material->eval(hit, Vec3(0, 0, 1), Vec3(0, 0.6f, 0.8f)), Color(0.0f)) << "unlit reflects nothing";
+  EXPECT_EQ(hit.material->eval(hit, Vec3(0, 0, 1), Vec3(0, 0.6f, 0.8f)), Color(0.0f))
+      << "unlit reflects nothing";
   // The light sample of the same point sees the same radiance.
   int triangles = 0;
   for (const auto& light : scene.lights) {
@@ -490,6 +492,62 @@ TEST(GltfAttributes, VertexColoursMultiplyTheBaseColour) {
   EXPECT_NEAR(ratio.x, 0.2f, 1e-5f);
   EXPECT_NEAR(ratio.y, 0.6f, 1e-5f);
   EXPECT_NEAR(ratio.z, 1.0f, 1e-5f);
+}
+
+// KHR_materials_variants: --variant NAME gives each primitive the material its mappings name for
+// that variant (others keep their own); `info` lists the variants; an unknown name is an error
+// listing them; a checkpoint keeps the variant.
+TEST(GltfVariants, VariantPicksTheMappedMaterial) {
+  TempDir dir;
+  GltfBuilder b;
+  const int red = b.addMaterial(pbr("red", {1, 0, 0, 1}, 0, 1));
+  const int blue = b.addMaterial(pbr("blue", {0, 0, 1, 1}, 0, 1));
+  b.addQuad(1.0f, red);
+  using V = tinygltf::Value;
+  b.model().extensions["KHR_materials_variants"] =
+      V(V::Object{{"variants", V(V::Array{V(V::Object{{"name", V(std::string("Red"))}}),
+                                          V(V::Object{{"name", V(std::string("Blue"))}})})}});
+  b.model().meshes.at(0).primitives.at(0).extensions["KHR_materials_variants"] = V(V::Object{
+      {"mappings", V(V::Array{V(V::Object{{"material", V(blue)}, {"variants", V(V::Array{V(1)})}})})}});
+  b.model().extensionsUsed.push_back("KHR_materials_variants");
+  const std::string path = dir.file("variants.gltf");
+  ASSERT_TRUE(b.write(path));
+
+  const auto materialAt = [](const Scene& scene) {
+    SurfaceHit hit;
+    EXPECT_TRUE(scene.intersect(Ray{Vec3(0.1f, 0.2f, 3.0f), Vec3(0.0f, 0.0f, -1.0f)}, hit));
+    return hit.material;
+  };
+  for (const auto& [variant, name] :
+       {std::pair{"", "red"}, std::pair{"Red", "red"}, std::pair{"Blue", "blue"}}) {
+    LoadOptions options;
+    options.variant = variant;
+    Scene scene = loadScene(path, options);
+    scene.build();
+    const Material* m = materialAt(scene);
+    size_t index = 0;
+    while (index < scene.materials.size() && scene.materials[index].get() != m) ++index;
+    ASSERT_LT(index, scene.materials.size());
+    EXPECT_EQ(scene.materialNames[index], name) << "variant '" << variant << "'";
+  }
+  LoadOptions unknown;
+  unknown.variant = "Green";
+  try {
+    loadScene(path, unknown);
+    ADD_FAILURE() << "an unknown variant loaded";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no variant named 'Green'; the file has: 'Red', 'Blue'"),
+              std::string::npos)
+        << e.what();
+  }
+  const auto info = test::runEmber("info '" + path + "'");
+  EXPECT_NE(info.output.find("variants:   2 'Red', 'Blue'"), std::string::npos) << info.output;
+  const auto render =
+      test::runEmber("render '" + path + "' --variant Blue --spp 2 --width 8 --height 8 -q -o " +
+                     dir.file("v.exr") + " --checkpoint " + dir.file("v.ckpt"));
+  EXPECT_EQ(render.exitCode, 0) << render.output;
+  const auto resumed = test::runEmber("render --resume " + dir.file("v.ckpt") + " -q");
+  EXPECT_EQ(resumed.exitCode, 0) << resumed.output;
 }
 
 TEST(GltfOverrides, UnknownMaterialNameListsTheFilesMaterials) {
