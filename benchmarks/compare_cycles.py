@@ -64,6 +64,8 @@ def main():
     ap.add_argument("--height", type=int, default=384)
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--out", default="/tmp/ember-cycles")
+    ap.add_argument("--single-scatter", action="store_true",
+                    help="Cycles' Principled BSDFs with single-scattering GGX, as glTF's Appendix B")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
 
@@ -89,7 +91,7 @@ def main():
         job = {"model": os.path.abspath(model), "origin": origin, "target": target, "spp": args.spp,
                "width": args.width, "height": args.height, "threads": args.threads,
                "cycles_exr": os.path.join(args.out, name + "-cycles.exr"), "ember_exr": ember_exr,
-               "png": os.path.join(args.out, name + ".png")}
+               "png": os.path.join(args.out, name + ".png"), "single_scatter": args.single_scatter}
         job_path = os.path.join(args.out, name + "-job.json")
         with open(job_path, "w") as f:
             json.dump(job, f)

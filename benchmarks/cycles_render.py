@@ -16,6 +16,13 @@ job = json.load(open(sys.argv[sys.argv.index("--") + 1]))
 bpy.ops.wm.read_factory_settings(use_empty=True)
 bpy.ops.import_scene.gltf(filepath=job["model"])
 scene = bpy.context.scene
+if job.get("single_scatter"):
+    # glTF's Appendix B is single-scattering GGX; Blender's Principled BSDF defaults to Kulla-Conty
+    # multiple scattering, which keeps the energy rough metals lose.
+    for material in bpy.data.materials:
+        for node in material.node_tree.nodes if material.node_tree else []:
+            if node.type == "BSDF_PRINCIPLED":
+                node.distribution = "GGX"
 
 
 def to_blender(p):

@@ -155,7 +155,7 @@ class GltfImporter {
         "KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_transmission",
         "KHR_materials_ior", "KHR_materials_volume", "KHR_texture_transform", "KHR_materials_specular",
         "KHR_materials_sheen", "KHR_materials_clearcoat", "KHR_materials_unlit", "KHR_materials_iridescence",
-        "KHR_materials_variants", "KHR_mesh_quantization",
+        "KHR_materials_anisotropy", "KHR_materials_variants", "KHR_mesh_quantization",
         // io/gltf_compression.cpp; KHR_texture_basisu by its textures' PNG/JPEG fallbacks alone.
         "EXT_meshopt_compression", "KHR_draco_mesh_compression", "EXT_texture_webp", "KHR_texture_basisu"};
     return supported;

@@ -202,6 +202,18 @@ GltfSurface GltfMaterialReader::convert(int index, bool vertexColors) {
     in.iridescenceThickness =
         extensionTexture(*ext, "iridescenceThicknessTexture", Channels::Green, Color(1.0f), w, out);
   }
+  // KHR_materials_anisotropy: strength, rotation, and a texture of direction (RG) and strength (B).
+  if (const tinygltf::Value* ext = extension(m.extensions, "KHR_materials_anisotropy")) {
+    const std::string w = where + ".extensions.KHR_materials_anisotropy";
+    in.anisotropyStrength = numberOr(*ext, "anisotropyStrength", 0.0f);
+    if (!(in.anisotropyStrength >= 0.0f && in.anisotropyStrength <= 1.0f))
+      fail(w + ".anisotropyStrength", "expected a number in [0, 1]");
+    in.anisotropyRotation = numberOr(*ext, "anisotropyRotation", 0.0f);
+    if (!std::isfinite(in.anisotropyRotation)) fail(w + ".anisotropyRotation", "expected a number (radians)");
+    in.anisotropy = extensionTexture(*ext, "anisotropyTexture", Channels::LinearRgb, Color(1.0f), w, out);
+    // The direction lives in the mesh's tangent frame: meshes without TANGENT get generated ones.
+    out.needsTangents = out.needsTangents || in.anisotropyStrength > 0.0f;
+  }
   // KHR_materials_clearcoat: weight (R), roughness (G) and a normal map of the coat's own.
   if (const tinygltf::Value* ext = extension(m.extensions, "KHR_materials_clearcoat")) {
     const std::string w = where + ".extensions.KHR_materials_clearcoat";
@@ -217,7 +229,7 @@ GltfSurface GltfMaterialReader::convert(int index, bool vertexColors) {
     if (!in.clearcoatRoughness) in.clearcoatRoughness = std::make_shared<ConstantTexture>(Color(roughness));
     in.clearcoatNormal = extensionTexture(*ext, "clearcoatNormalTexture", Channels::LinearRgb, Color(1.0f), w,
                                           out, &in.clearcoatNormalScale);
-    out.needsTangents = in.clearcoatNormal != nullptr;
+    out.needsTangents = out.needsTangents || in.clearcoatNormal != nullptr;
   }
   if (const tinygltf::Value* ext = extension(m.extensions, "KHR_materials_volume")) {
     const float thickness = numberOr(*ext, "thicknessFactor", 0.0f);

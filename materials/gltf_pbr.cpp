@@ -93,6 +93,7 @@ GltfPbrMaterial::GltfPbrMaterial(GltfPbrInputs inputs) : inputs_(std::move(input
   sheen_ = inputs_.sheenColor && !isBlack(inputs_.sheenColor->maxValue());
   coat_ = inputs_.clearcoat && inputs_.clearcoat->maxValue().x > 0.0f;
   film_ = inputs_.iridescence && inputs_.iridescence->maxValue().x > 0.0f;
+  anisotropic_ = inputs_.anisotropyStrength > 0.0f;
 }
 
 const GltfPbrMaterial::Params& GltfPbrMaterial::fetchFor(const SurfaceHit& hit) const {
@@ -104,9 +105,11 @@ GltfPbrMaterial::Params GltfPbrMaterial::fetch(const SurfaceHit& hit) const {
   p.baseColor = Color(1.0f);
   p.metallic = 1.0f;
   if (inputs_.baseColor) p.baseColor = glm::max(inputs_.baseColor->evalAt(hit), Color(0.0f));
+  float roughness = 1.0f;
   if (inputs_.metallicRoughness) {
     const Color mr = inputs_.metallicRoughness->evalAt(hit);
-    p.ggx = Ggx::fromRoughness(std::clamp(mr.g, 0.0f, 1.0f));
+    roughness = std::clamp(mr.g, 0.0f, 1.0f);
+    p.ggx = Ggx::fromRoughness(roughness);
     p.metallic = std::clamp(mr.b, 0.0f, 1.0f);
   }
   if (inputs_.transmission) p.transmission = std::clamp(inputs_.transmission->evalAt(hit).r, 0.0f, 1.0f);
@@ -131,6 +134,7 @@ GltfPbrMaterial::Params GltfPbrMaterial::fetch(const SurfaceHit& hit) const {
                                      hit.texCoord(inputs_.clearcoatNormal->texCoordSet()));
     p.coatNormal = glm::dot(n, hit.ng) < 0.0f ? -n : n;
   }
+  if (anisotropic_) fetchAnisotropy(hit, roughness, p);
   if (film_) {
     p.iridescence = std::clamp(inputs_.iridescence->evalAt(hit).r, 0.0f, 1.0f);
     const float t = inputs_.iridescenceThickness
@@ -142,9 +146,47 @@ GltfPbrMaterial::Params GltfPbrMaterial::fetch(const SurfaceHit& hit) const {
   return p;
 }
 
+void GltfPbrMaterial::fetchAnisotropy(const SurfaceHit& hit, float roughness, Params& p) const {
+  // The direction in tangent space: the texture's RG mapped to [-1, 1] (default (1, 0)), rotated
+  // by anisotropyRotation; the strength times the texture's B (KHR_materials_anisotropy).
+  Vec2 d(1.0f, 0.0f);
+  float strength = inputs_.anisotropyStrength;
+  if (inputs_.anisotropy) {
+    const Color t = inputs_.anisotropy->evalAt(hit);
+    const Vec2 texel(2.0f * t.x - 1.0f, 2.0f * t.y - 1.0f);
+    const float len = glm::length(texel);
+    d = len > 1e-6f ? texel / len : Vec2(1.0f, 0.0f);
+    strength *= std::clamp(t.z, 0.0f, 1.0f);
+  }
+  const float c = std::cos(inputs_.anisotropyRotation), s = std::sin(inputs_.anisotropyRotation);
+  d = Vec2(c * d.x - s * d.y, s * d.x + c * d.y);
+  p.ggx = Ggx::anisotropic(roughness, std::clamp(strength, 0.0f, 1.0f));
+  // The world direction in the (T, B, N) frame of the mesh (B = cross(N, T) w, glTF 2.0 section
+  // 3.7.2.1); without tangents (an analytic shape) the shading frame's own first axis.
+  if (!hit.attributes) return;
+  const glm::vec4 tangent = hit.attributes->tangentAt(hit.prim, hit.bary);
+  const Vec3 n = hit.attributes->normalAt(hit.prim, hit.bary);
+  Vec3 t = Vec3(tangent) - n * glm::dot(n, Vec3(tangent));
+  const float tl = glm::length(t);
+  if (!(tl > 1e-6f)) return;
+  t /= tl;
+  const Vec3 b = glm::cross(n, t) * (tangent.w < 0.0f ? -1.0f : 1.0f);
+  p.anisotropyDirection = d.x * t + d.y * b;
+}
+
 bool GltfPbrMaterial::frames(const SurfaceHit& hit, const Vec3& wo, const Params& p, Frames& f) const {
   f.outside = glm::dot(wo, hit.ng) >= 0.0f;
   f.base = Frame(f.outside ? hit.ns : -hit.ns);  // facingNormal(hit, wo)
+  if (anisotropic_) {
+    // The x axis along the anisotropy direction, made orthogonal to the shading normal; without
+    // one, Frame's own x axis.
+    const Vec3 t = p.anisotropyDirection - f.base.n * glm::dot(f.base.n, p.anisotropyDirection);
+    const float tl = glm::length(t);
+    if (tl > 1e-6f) {
+      f.base.s = t / tl;
+      f.base.t = glm::cross(f.base.n, f.base.s);
+    }
+  }
   f.o = f.base.toLocal(wo);
   if (!(f.o.z > 0.0f)) return false;  // wo under the shading hemisphere
   f.layers = !refracts_ || f.outside;

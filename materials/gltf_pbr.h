@@ -13,6 +13,9 @@
 //                    (KHR_materials_sheen; materials/sheen.h)
 //   Fr, F_metal    = mix(schlick, F_thin_film, iridescence)   (KHR_materials_iridescence;
 //                    materials/iridescence.h)
+//   alpha_t, alpha_b = mix(roughness^2, 1, anisotropy^2), roughness^2 along and across the
+//                    anisotropy direction (KHR_materials_anisotropy; anisotropic GGX D and Smith V,
+//                    Heitz 2014 eqs. 80, 82, sampled by Heitz 2018's stretched visible normals)
 //   coated         = mix(sheen layer, clearcoat_brdf, clearcoat * schlick(0.04, n_c.v))
 //                    (KHR_materials_clearcoat: a GGX lobe of its own roughness about its own normal
 //                    n_c, the geometry's normal or its own normal map)
@@ -53,6 +56,11 @@ struct GltfPbrInputs {
   // blends between the minimum and maximum thickness (nm; null = the maximum); the film's ior.
   std::shared_ptr<const Texture> iridescence, iridescenceThickness;
   float iridescenceIor = 1.3f, iridescenceThicknessMin = 100.0f, iridescenceThicknessMax = 400.0f;
+  // KHR_materials_anisotropy: the strength (> 0: anisotropic), the rotation (radians, from the
+  // tangent towards the bitangent) and the texture (linear RGB: direction RG in [-1, 1] tangent
+  // space, strength B; null = direction (1, 0), strength 1).
+  float anisotropyStrength = 0.0f, anisotropyRotation = 0.0f;
+  std::shared_ptr<const Texture> anisotropy;
   float ior = 1.5f;  // 0: the dielectric reflects totally (f0 = 1), as KHR_materials_ior allows
   // KHR_materials_transmission without KHR_materials_volume is thin-walled: light passes through
   // the surface without bending. With a volume (thicknessFactor > 0) the surface is a refracting
@@ -99,6 +107,7 @@ class GltfPbrMaterial final : public Material {
     Ggx coatGgx = Ggx::fromRoughness(0.0f);
     Vec3 coatNormal{0.0f};                           // world space, on the side of hit.ng
     float iridescence = 0.0f, filmThickness = 0.0f;  // nm
+    Vec3 anisotropyDirection{0.0f};                  // world space, where ggx is anisotropic: its x axis
   };
   // Probabilities with which sample() picks its lobes (they sum to 1).
   struct LobeProbabilities {
@@ -113,6 +122,8 @@ class GltfPbrMaterial final : public Material {
   };
 
   Params fetch(const SurfaceHit& hit) const;
+  // KHR_materials_anisotropy's distribution and direction at the hit, into p.
+  void fetchAnisotropy(const SurfaceHit& hit, float roughness, Params& p) const;
   // fetch(hit.uv), remembered for the hit (materials/hit_memo.h): a vertex asks twice, for the
   // light sample's evalPdf and for sample. The reference stays valid until the thread's next
   // fetchFor.
@@ -138,11 +149,11 @@ class GltfPbrMaterial final : public Material {
   Color evalAndPdf(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi, float& pdf) const;
 
   GltfPbrInputs inputs_;
-  float ior_;                 // max(ior, 1)
-  float f0_;                  // ((ior - 1) / (ior + 1))^2, the dielectric's normal-incidence reflectance
-  bool sheen_, coat_, film_;  // the layers are present
-  bool refracts_;             // a volumetric (bending) transmission lobe: !thinWalled and ior_ > 1
-  uint64_t id_;               // fetchFor's memo key: newHitMemoOwner()
+  float ior_;  // max(ior, 1)
+  float f0_;   // ((ior - 1) / (ior + 1))^2, the dielectric's normal-incidence reflectance
+  bool sheen_, coat_, film_, anisotropic_;  // the layers are present
+  bool refracts_;  // a volumetric (bending) transmission lobe: !thinWalled and ior_ > 1
+  uint64_t id_;    // fetchFor's memo key: newHitMemoOwner()
 };
 
 }  // namespace ember

@@ -1,6 +1,8 @@
-// The isotropic Trowbridge-Reitz (GGX) microfacet distribution and the pieces of a microfacet BSDF
-// built on it, in a local frame where the macro-surface normal is +z. Every direction is unit
-// length; h is a microfacet normal with h.z > 0.
+// The Trowbridge-Reitz (GGX) microfacet distribution and the pieces of a microfacet BSDF built on
+// it, in a local frame where the macro-surface normal is +z, isotropic or anisotropic with
+// roughness alphaX along the frame's x axis and alphaY along its y axis (Heitz 2014, eqs. 80 and
+// 82; KHR_materials_anisotropy). Every direction is unit length; h is a microfacet normal with
+// h.z > 0.
 //
 // References:
 //  - Trowbridge & Reitz 1975; Walter, Marschner, Li, Torrance 2007, "Microfacet Models for
@@ -41,26 +43,44 @@ struct Ggx {
   // (a perfect mirror) is kept.
   static constexpr float kMinAlpha = 1e-3f;
 
-  float alpha;
+  float alphaX, alphaY;
 
-  explicit Ggx(float a) : alpha(std::max(a, kMinAlpha)) {}
+  explicit Ggx(float a) : alphaX(std::max(a, kMinAlpha)), alphaY(alphaX) {}
+  Ggx(float ax, float ay) : alphaX(std::max(ax, kMinAlpha)), alphaY(std::max(ay, kMinAlpha)) {}
   // glTF's perceptual roughness maps to alpha = roughness^2 (glTF 2.0 Appendix B.3.2).
   static Ggx fromRoughness(float roughness) { return Ggx(roughness * roughness); }
+  // KHR_materials_anisotropy: along the anisotropy direction (the frame's x axis) alpha rises to
+  // mix(roughness^2, 1, strength^2); across it, it stays roughness^2.
+  static Ggx anisotropic(float roughness, float strength) {
+    const float a = roughness * roughness, s2 = strength * strength;
+    return Ggx(a + (1.0f - a) * s2, a);
+  }
+  bool isotropic() const { return alphaX == alphaY; }
 
   // D(h) = alpha^2 / (pi ((n.h)^2 (alpha^2 - 1) + 1)^2) (Walter 2007 eq. 33, glTF B.3.2). Written
   // as 1 / (pi alpha^2 t^2), t = (h.x^2 + h.y^2) / alpha^2 + h.z^2, since (n.h)^2 (alpha^2 - 1) + 1
   // = sin^2 + alpha^2 cos^2 and sin^2 is exact from h.x, h.y where 1 - h.z^2 cancels for narrow
   // lobes.
+  // Anisotropic: 1 / (pi ax ay t^2), t = h.x^2 / ax^2 + h.y^2 / ay^2 + h.z^2 (Heitz 2014 eq. 82);
+  // the isotropic case keeps its own expression.
   float D(const Vec3& h) const {
     if (h.z <= 0.0f) return 0.0f;
-    const float a2 = alpha * alpha;
-    const float t = (h.x * h.x + h.y * h.y) / a2 + h.z * h.z;
-    return 1.0f / (kPi * a2 * t * t);
+    if (isotropic()) {
+      const float a2 = alphaX * alphaX;
+      const float t = (h.x * h.x + h.y * h.y) / a2 + h.z * h.z;
+      return 1.0f / (kPi * a2 * t * t);
+    }
+    const float t = h.x * h.x / (alphaX * alphaX) + h.y * h.y / (alphaY * alphaY) + h.z * h.z;
+    return 1.0f / (kPi * alphaX * alphaY * t * t);
   }
 
   // sqrt(cos^2 (1 - alpha^2) + alpha^2) = sqrt(cos^2 + alpha^2 sin^2) for a unit w, the recurring
   // term of Lambda and of the glTF visibility term; |w.z| + this = 2 |w.z| (1 + Lambda(w)).
-  float root(const Vec3& w) const { return std::sqrt(w.z * w.z + alpha * alpha * (w.x * w.x + w.y * w.y)); }
+  // Anisotropic: sqrt(w.z^2 + ax^2 w.x^2 + ay^2 w.y^2) (Heitz 2014 eq. 80, the projected roughness).
+  float root(const Vec3& w) const {
+    if (isotropic()) return std::sqrt(w.z * w.z + alphaX * alphaX * (w.x * w.x + w.y * w.y));
+    return std::sqrt(w.z * w.z + alphaX * alphaX * w.x * w.x + alphaY * alphaY * w.y * w.y);
+  }
 
   // Smith Lambda(w) = (-1 + sqrt(1 + alpha^2 tan^2 theta)) / 2 (Heitz 2014 eq. 72); symmetric in
   // the sign of w.z (the microsurface seen from below is the mirrored one, for transmission).
@@ -97,7 +117,7 @@ struct Ggx {
   // s = (1 + Vh.z) / 2), lift back onto the hemisphere and unstretch. (The listing clamps nh.z at 0;
   // 1e-7 keeps a sample exactly at the horizon of the hemisphere from becoming h.z = 0, where D = 0.)
   Vec3 sampleVisibleNormal(const Vec3& wo, Vec2 u) const {
-    const Vec3 vh = glm::normalize(Vec3(alpha * wo.x, alpha * wo.y, wo.z));
+    const Vec3 vh = glm::normalize(Vec3(alphaX * wo.x, alphaY * wo.y, wo.z));
     const float lensq = vh.x * vh.x + vh.y * vh.y;
     const Vec3 t1 = lensq > 0.0f ? Vec3(-vh.y, vh.x, 0.0f) / std::sqrt(lensq) : Vec3(1.0f, 0.0f, 0.0f);
     const Vec3 t2 = glm::cross(vh, t1);
@@ -108,7 +128,7 @@ struct Ggx {
     const float s = 0.5f * (1.0f + vh.z);
     p2 = (1.0f - s) * std::sqrt(std::max(0.0f, 1.0f - p1 * p1)) + s * p2;
     const Vec3 nh = p1 * t1 + p2 * t2 + std::sqrt(std::max(0.0f, 1.0f - p1 * p1 - p2 * p2)) * vh;
-    return glm::normalize(Vec3(alpha * nh.x, alpha * nh.y, std::max(1e-7f, nh.z)));
+    return glm::normalize(Vec3(alphaX * nh.x, alphaY * nh.y, std::max(1e-7f, nh.z)));
   }
   // Density of sampleVisibleNormal in h: D_wo(h) = G1(wo) max(0, wo.h) D(h) / wo.z (Heitz 2018
   // eq. 1), with G1(wo) / wo.z = 2 / (wo.z + root(wo)) so that it stays finite at grazing wo.

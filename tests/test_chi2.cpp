@@ -96,7 +96,7 @@ namespace {
 // Parameters of the test as a whole.
 
 constexpr double kAlpha = 0.01;     // family-wise significance level over every case in the file
-constexpr int kNumCases = 77;       // m for the Sidak correction: must equal allCases().size()
+constexpr int kNumCases = 79;       // m for the Sidak correction: must equal allCases().size()
 constexpr long kSamples = 1000000;  // samples per case
 constexpr double kMinExpected = 5.0;
 // Absolute error allowed on integrals of the pdf over the sphere: the midpoint rule on the
@@ -1027,6 +1027,30 @@ const std::vector<Chi2Case>& allCases() {
       l.coat = 1.0f;
       l.coatRoughness = 0.3f;
       runMaterial(layered(0.5f, 0.0f, 0.0f, true, l), Vec3(-0.3f, 0.1f, 0.5f), s, false, &tilted);
+    });
+    // KHR_materials_anisotropy: a rough metal stretched along a direction 0.9 rad from the
+    // tangent, seen obliquely across it (the stretched visible normals of Heitz 2018).
+    struct Tangent final : VertexAttributes {
+      Vec2 texCoordAt(int, uint32_t, Vec2 b) const override { return b; }
+      glm::vec4 colorAt(uint32_t, Vec2) const override { return glm::vec4(1.0f); }
+      Vec3 normalAt(uint32_t, Vec2) const override { return Vec3(0.0f, 0.0f, 1.0f); }
+      glm::vec4 tangentAt(uint32_t, Vec2) const override { return glm::vec4(1.0f, 0.0f, 0.0f, 1.0f); }
+    };
+    static const Tangent tangent;
+    add("GltfAnisotropy_s0p8_r0p2_m1_woOblique", [=](uint64_t s) {
+      GltfPbrInputs in;
+      in.baseColor = constant(Color(0.8f, 0.6f, 0.3f));
+      in.metallicRoughness = constant(Color(0.0f, 0.2f, 1.0f));
+      in.anisotropyStrength = 0.8f;
+      in.anisotropyRotation = 0.9f;
+      runMaterial(std::make_shared<GltfPbrMaterial>(std::move(in)), woOblique, s, false, &tangent);
+    });
+    add("GltfAnisotropy_s0p5_r0p4_dielectric_woGrazing", [=](uint64_t s) {
+      GltfPbrInputs in;
+      in.baseColor = constant(Color(0.5f, 0.3f, 0.2f));
+      in.metallicRoughness = constant(Color(0.0f, 0.4f, 0.0f));
+      in.anisotropyStrength = 0.5f;
+      runMaterial(std::make_shared<GltfPbrMaterial>(std::move(in)), woGrazing, s, false, &tangent);
     });
     for (const LayeredCase& lc : layeredCases) {
       add(lc.name, [=](uint64_t s) {

@@ -336,6 +336,85 @@ TEST(GltfLayers, ThinFilmLimits) {
     }
 }
 
+// A mesh point with normal +z and tangent (1, 0, 0), bitangent sign w: the frame in which the
+// anisotropy direction is given.
+struct TangentFrame final : VertexAttributes {
+  float w = 1.0f;
+  Vec2 texCoordAt(int, uint32_t, Vec2 b) const override { return b; }
+  glm::vec4 colorAt(uint32_t, Vec2) const override { return glm::vec4(1.0f); }
+  Vec3 normalAt(uint32_t, Vec2) const override { return Vec3(0.0f, 0.0f, 1.0f); }
+  glm::vec4 tangentAt(uint32_t, Vec2) const override { return glm::vec4(1.0f, 0.0f, 0.0f, w); }
+};
+
+// KHR_materials_anisotropy: a metal's f cos equals the extension's D_GGX_anisotropic and
+// V_GGX_anisotropic (written here from its implementation section, the V without its clamp, as
+// Appendix B's isotropic V has none) with alpha_t = mix(alpha, 1, strength^2) along the direction
+// rotated from the tangent by anisotropyRotation, towards the bitangent of either handedness.
+TEST(GltfLayers, AnisotropyMatchesTheKhronosDefinition) {
+  for (const float w : {1.0f, -1.0f}) {
+    TangentFrame frame;
+    frame.w = w;
+    SurfaceHit hit = test::flatHit();
+    hit.attributes = &frame;
+    GltfPbrInputs in;
+    in.baseColor = constant(Color(0.9f, 0.6f, 0.3f));
+    in.metallicRoughness = constant(Color(0.0f, 0.35f, 1.0f));
+    in.anisotropyStrength = 0.7f;
+    in.anisotropyRotation = 0.5f;
+    const GltfPbrMaterial m(in);
+    const double alpha = 0.35 * 0.35, at = alpha + (1.0 - alpha) * 0.49, ab = alpha;
+    const D3 t(std::cos(0.5), w * std::sin(0.5), 0.0);  // B = cross(N, T) w = w y
+    const D3 b = glm::cross(D3(0, 0, 1), t);
+    Rng rng(17, 2);
+    for (int k = 0; k < 300; ++k) {
+      const D3 v(randomUpper(rng)), l(randomUpper(rng));
+      const D3 h = glm::normalize(v + l);
+      const double a2 = at * ab;
+      const D3 f(ab * glm::dot(t, h), at * glm::dot(b, h), a2 * h.z);
+      const double w2 = a2 / glm::dot(f, f);
+      const double D = a2 * w2 * w2 / kPiD;
+      const double gv = l.z * glm::length(D3(at * glm::dot(t, v), ab * glm::dot(b, v), v.z));
+      const double gl = v.z * glm::length(D3(at * glm::dot(t, l), ab * glm::dot(b, l), l.z));
+      const double V = 0.5 / (gv + gl);
+      glm::dvec3 want;
+      for (int c = 0; c < 3; ++c)
+        want[c] = schlick(in.baseColor->maxValue()[c], glm::dot(v, h)) * D * V * l.z;
+      expectNear(m.eval(hit, Vec3(v), Vec3(l)), want, 2e-4, "anisotropy, w " + std::to_string(w));
+    }
+  }
+}
+
+// A white anisotropic metal reflects at most all light, and no less than its roughest direction
+// alone would: between the isotropic albedos at alpha = 1 and at its own roughness.
+TEST(GltfLayers, AnisotropicWhiteMetalStaysWithinItsIsotropicBounds) {
+  TangentFrame frame;
+  SurfaceHit hit = test::flatHit();
+  hit.attributes = &frame;
+  const auto albedo = [&](float roughness, float strength, float mu) {
+    GltfPbrInputs in;
+    in.baseColor = constant(Color(1.0f));
+    in.metallicRoughness = constant(Color(0.0f, roughness, 1.0f));
+    in.anisotropyStrength = strength;
+    const GltfPbrMaterial m(in);
+    const Vec3 wo(std::sqrt(1.0f - mu * mu), 0.0f, mu);
+    Rng rng(23, 4);
+    test::McMean mean;
+    for (int k = 0; k < 100000; ++k) {
+      BsdfSample s;
+      mean.add(m.sample(hit, wo, Vec2(rng.uniform(), rng.uniform()), rng.uniform(), s) ? double(s.weight.x)
+                                                                                       : 0.0);
+    }
+    return mean;
+  };
+  for (float mu : {0.3f, 0.8f}) {
+    const test::McMean aniso = albedo(0.3f, 0.8f, mu), smooth = albedo(0.3f, 0.0f, mu),
+                       rough = albedo(1.0f, 0.0f, mu);
+    EXPECT_LE(aniso.mean(), smooth.mean() + aniso.tolerance() + smooth.tolerance()) << "cos " << mu;
+    EXPECT_GE(aniso.mean(), rough.mean() - aniso.tolerance() - rough.tolerance()) << "cos " << mu;
+    EXPECT_LE(aniso.mean(), 1.0 + aniso.tolerance(1e-4)) << "cos " << mu;
+  }
+}
+
 // f(wo, wi) = f(wi, wo) for the specular and sheen layers (their scaling is symmetric by the min).
 TEST(GltfLayers, SpecularAndSheenAreReciprocal) {
   const SurfaceHit hit = test::flatHit();

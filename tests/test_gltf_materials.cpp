@@ -648,6 +648,35 @@ TEST(GltfErrors, BadMaterialValuesNameTheirPlace) {
          m.extensions["KHR_materials_transmission"] = V(V::Object{{"transmissionFactor", V(2.0)}});
        },
        "KHR_materials_transmission.transmissionFactor: expected a number in [0, 1]"},
+      {"specular colour",
+       [](GltfBuilder&, tinygltf::Material& m) {
+         m.extensions["KHR_materials_specular"] =
+             V(V::Object{{"specularColorFactor", V(V::Array{V(1.0), V(-1.0), V(1.0)})}});
+       },
+       "materials[0].extensions.KHR_materials_specular.specularColorFactor: expected numbers in [0, inf)"},
+      {"sheen roughness",
+       [](GltfBuilder&, tinygltf::Material& m) {
+         m.extensions["KHR_materials_sheen"] = V(V::Object{{"sheenRoughnessFactor", V(1.5)}});
+       },
+       "materials[0].extensions.KHR_materials_sheen.sheenRoughnessFactor: expected a number in [0, 1]"},
+      {"clearcoat texture",
+       [](GltfBuilder&, tinygltf::Material& m) {
+         m.extensions["KHR_materials_clearcoat"] =
+             V(V::Object{{"clearcoatFactor", V(1.0)}, {"clearcoatTexture", V(V::Object{{"index", V(7)}})}});
+       },
+       "materials[0].extensions.KHR_materials_clearcoat.clearcoatTexture: texture index out of range"},
+      {"iridescence thickness",
+       [](GltfBuilder&, tinygltf::Material& m) {
+         m.extensions["KHR_materials_iridescence"] =
+             V(V::Object{{"iridescenceFactor", V(1.0)}, {"iridescenceThicknessMaximum", V(-5.0)}});
+       },
+       "KHR_materials_iridescence.iridescenceThicknessMaximum: expected a thickness >= 0 (nm)"},
+      {"anisotropy strength",
+       [](GltfBuilder&, tinygltf::Material& m) {
+         m.extensions["KHR_materials_anisotropy"] =
+             V(V::Object{{"anisotropyStrength", V(std::string("high"))}});
+       },
+       "KHR_materials_anisotropy.anisotropyStrength: expected a number in [0, 1]"},
       {"texture transform",
        [](GltfBuilder& b, tinygltf::Material& m) {
          m.emissiveFactor = {1, 1, 1};
