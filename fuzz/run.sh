@@ -15,8 +15,8 @@ mkdir -p "$corpus"/{scene_json,gltf,checkpoint,image}
 # Seeds: Ember's own scenes; glTF files of every kind, valid and deliberately broken (Debian's
 # assimp-testmodels, the generated showcases, the Khronos samples beside a checkout, the inputs
 # fuzzing found crashing: tests/data/fuzz, so each stays fixed under the sanitizers; fuzz/seeds,
-# files that reach parts of the loader the others do not, such as sparse accessors and the meshopt,
-# Draco and WebP decoders); a real
+# files that reach parts of the loader the others do not, such as sparse accessors, the meshopt,
+# Draco and WebP decoders, the KHR material extensions, TEXCOORD_1, COLOR_0 and variants); a real
 # checkpoint. Copied, so the fuzzer's new inputs never land in the source tree.
 cp scenes/*.json "$corpus/scene_json/"
 # Only the folders that exist: find fails on a missing one, and pipefail would end the run (a clone

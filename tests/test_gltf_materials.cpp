@@ -7,6 +7,7 @@
 #include "materials/texture.h"
 #include "renderer/light.h"
 #include "test_fixtures.h"
+#include "test_paths.h"
 
 #include <gtest/gtest.h>
 
@@ -548,6 +549,21 @@ TEST(GltfVariants, VariantPicksTheMappedMaterial) {
   EXPECT_EQ(render.exitCode, 0) << render.output;
   const auto resumed = test::runEmber("render --resume " + dir.file("v.ckpt") + " -q");
   EXPECT_EQ(resumed.exitCode, 0) << resumed.output;
+}
+
+// The fuzz seed for the material extensions, attributes and variants (fuzz/seeds) loads with
+// either variant: every layer, TEXCOORD_1, COLOR_0, MASK and BLEND, ranged lights.
+TEST(GltfVariants, MaterialsSeedLoadsWithEveryVariant) {
+  const std::string path = test::sourcePath("fuzz/seeds/khr-materials-attributes-variants.gltf");
+  for (const char* variant : {"", "Layered", "Unlit"}) {
+    LoadOptions options;
+    options.variant = variant;
+    Scene scene = loadScene(path, options);
+    scene.build();
+    EXPECT_EQ(scene.materialVariants.size(), 2u);
+    const Film film = test::renderFilm(scene, 2, 1);
+    EXPECT_TRUE(isFinite(film.mean().at(0, 0))) << variant;
+  }
 }
 
 TEST(GltfOverrides, UnknownMaterialNameListsTheFilesMaterials) {
