@@ -27,6 +27,26 @@ TEST(Tonemap, ReinhardMatchesHandComputedValues) {
   EXPECT_EQ(r.rgb8[0], uint8_t(std::lround(255.0f * linearToSrgb(expectedDark))));
 }
 
+// A model on an empty black background: the key is the model's. Two pixels of luminance 1 and 4
+// among 98 black ones give the same log-average (2) and the same display values as the two alone,
+// where averaging the black pixels in (log delta = -13.8 each) would scale the model up ~10^5 times
+// and blow it out to white.
+TEST(Tonemap, BlackBackgroundDoesNotSetTheKey) {
+  Image alone(2, 1), onBlack(10, 10);
+  alone.set(0, 0, Color(1.0f));
+  alone.set(1, 0, Color(4.0f));
+  onBlack.set(3, 4, Color(1.0f));
+  onBlack.set(6, 5, Color(4.0f));
+  float a = 0.0f, b = 0.0f;
+  const Image x = reinhardLinear(alone, ReinhardParams{}, &a),
+              y = reinhardLinear(onBlack, ReinhardParams{}, &b);
+  EXPECT_NEAR(b, 2.0f, 1e-5f);
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(x.at(0, 0), y.at(3, 4));
+  EXPECT_EQ(x.at(1, 0), y.at(6, 5));
+  EXPECT_LT(y.at(3, 4).x, 0.2f) << "the dim pixel keeps a dim display value";
+}
+
 TEST(Tonemap, KeyAndWhiteAreHonoured) {
   Image img(2, 1);
   img.set(0, 0, Color(1.0f));
