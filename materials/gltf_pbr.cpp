@@ -104,26 +104,26 @@ GltfPbrMaterial::Params GltfPbrMaterial::fetch(const SurfaceHit& hit) const {
   Params p;
   p.baseColor = Color(1.0f);
   p.metallic = 1.0f;
-  if (inputs_.baseColor) p.baseColor = glm::max(inputs_.baseColor->evalAt(hit), Color(0.0f));
+  if (inputs_.baseColor) p.baseColor = glm::max(inputs_.baseColor->evalFresh(hit), Color(0.0f));
   float roughness = 1.0f;
   if (inputs_.metallicRoughness) {
-    const Color mr = inputs_.metallicRoughness->evalAt(hit);
+    const Color mr = inputs_.metallicRoughness->evalFresh(hit);
     roughness = std::clamp(mr.g, 0.0f, 1.0f);
     p.ggx = Ggx::fromRoughness(roughness);
     p.metallic = std::clamp(mr.b, 0.0f, 1.0f);
   }
-  if (inputs_.transmission) p.transmission = std::clamp(inputs_.transmission->evalAt(hit).r, 0.0f, 1.0f);
+  if (inputs_.transmission) p.transmission = std::clamp(inputs_.transmission->evalFresh(hit).r, 0.0f, 1.0f);
   const Color specularColor =
-      inputs_.specularColor ? glm::max(inputs_.specularColor->evalAt(hit), Color(0.0f)) : Color(1.0f);
+      inputs_.specularColor ? glm::max(inputs_.specularColor->evalFresh(hit), Color(0.0f)) : Color(1.0f);
   p.specularF0 = glm::min(f0_ * specularColor, Color(1.0f));
-  if (inputs_.specular) p.specularWeight = std::clamp(inputs_.specular->evalAt(hit).r, 0.0f, 1.0f);
+  if (inputs_.specular) p.specularWeight = std::clamp(inputs_.specular->evalFresh(hit).r, 0.0f, 1.0f);
   if (sheen_) {
-    p.sheenColor = glm::clamp(inputs_.sheenColor->evalAt(hit), Color(0.0f), Color(1.0f));
-    p.sheenRoughness = inputs_.sheenRoughness ? inputs_.sheenRoughness->evalAt(hit).r : 0.0f;
+    p.sheenColor = glm::clamp(inputs_.sheenColor->evalFresh(hit), Color(0.0f), Color(1.0f));
+    p.sheenRoughness = inputs_.sheenRoughness ? inputs_.sheenRoughness->evalFresh(hit).r : 0.0f;
   }
   if (coat_) {
-    p.clearcoat = std::clamp(inputs_.clearcoat->evalAt(hit).r, 0.0f, 1.0f);
-    const float roughness = inputs_.clearcoatRoughness ? inputs_.clearcoatRoughness->evalAt(hit).r : 0.0f;
+    p.clearcoat = std::clamp(inputs_.clearcoat->evalFresh(hit).r, 0.0f, 1.0f);
+    const float roughness = inputs_.clearcoatRoughness ? inputs_.clearcoatRoughness->evalFresh(hit).r : 0.0f;
     p.coatGgx = Ggx::fromRoughness(std::clamp(roughness, 0.0f, 1.0f));
     // The coat's normal: the geometry's interpolated one, not the base's normal map (the
     // extension: "if clearcoatNormalTexture is not given, no normal mapping is applied").
@@ -136,9 +136,9 @@ GltfPbrMaterial::Params GltfPbrMaterial::fetch(const SurfaceHit& hit) const {
   }
   if (anisotropic_) fetchAnisotropy(hit, roughness, p);
   if (film_) {
-    p.iridescence = std::clamp(inputs_.iridescence->evalAt(hit).r, 0.0f, 1.0f);
+    p.iridescence = std::clamp(inputs_.iridescence->evalFresh(hit).r, 0.0f, 1.0f);
     const float t = inputs_.iridescenceThickness
-                        ? std::clamp(inputs_.iridescenceThickness->evalAt(hit).r, 0.0f, 1.0f)
+                        ? std::clamp(inputs_.iridescenceThickness->evalFresh(hit).r, 0.0f, 1.0f)
                         : 1.0f;
     p.filmThickness = inputs_.iridescenceThicknessMin +
                       (inputs_.iridescenceThicknessMax - inputs_.iridescenceThicknessMin) * t;
@@ -152,7 +152,7 @@ void GltfPbrMaterial::fetchAnisotropy(const SurfaceHit& hit, float roughness, Pa
   Vec2 d(1.0f, 0.0f);
   float strength = inputs_.anisotropyStrength;
   if (inputs_.anisotropy) {
-    const Color t = inputs_.anisotropy->evalAt(hit);
+    const Color t = inputs_.anisotropy->evalFresh(hit);
     const Vec2 texel(2.0f * t.x - 1.0f, 2.0f * t.y - 1.0f);
     const float len = glm::length(texel);
     d = len > 1e-6f ? texel / len : Vec2(1.0f, 0.0f);

@@ -21,6 +21,9 @@ class Texture {
   // eval(hit.uv) for a material shading `hit`, which asks more than once per vertex: textures
   // whose lookup costs more than a memo's check remember it per hit (materials/hit_memo.h).
   virtual Color evalAt(const SurfaceHit& hit) const { return eval(hit.uv); }
+  // evalAt without the per-hit memo, for a caller that remembers the whole vertex's inputs itself
+  // (GltfPbrMaterial::fetchFor): a second memo under it would only cost its check and store.
+  virtual Color evalFresh(const SurfaceHit& hit) const { return eval(hit.texCoord(texCoordSet())); }
   // Largest value the texture can return per channel (used for sampling decisions).
   virtual Color maxValue() const = 0;
   // Mean over the texture's area.
@@ -144,6 +147,9 @@ class VertexColorTexture final : public Texture {
  public:
   explicit VertexColorTexture(std::shared_ptr<const Texture> inner) : inner_(std::move(inner)) {}
   Color eval(Vec2 uv) const override { return inner_->eval(uv); }
+  Color evalFresh(const SurfaceHit& hit) const override {
+    return inner_->evalFresh(hit) * Color(hit.vertexColor());
+  }
   Color evalAt(const SurfaceHit& hit) const override {
     return inner_->evalAt(hit) * Color(hit.vertexColor());
   }

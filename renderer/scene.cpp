@@ -207,7 +207,7 @@ void Scene::surfaceHit(const Ray& ray, const RawHit& raw, SurfaceHit& hit) const
   hit.maskFront = rec.maskFront;
   hit.maskBack = rec.maskBack;
   if (rec.maps && rec.maps->emission && !isBlack(rec.emission))
-    hit.emission *= rec.maps->emission->evalAt(hit);
+    hit.emission *= rec.maps->emission->evalFresh(hit);
 }
 
 void Scene::prefetchTriangle(uint32_t geomID, uint32_t primID) const {
