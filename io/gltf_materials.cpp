@@ -62,8 +62,7 @@ std::shared_ptr<const Texture> GltfMaterialReader::extensionTexture(const tinygl
                                                                     const char* key, Channels channels,
                                                                     const Color& scale,
                                                                     const std::string& where,
-                                                                    GltfSurface& out, float* normalScale) {
-  (void)out;
+                                                                    float* normalScale) {
   if (!ext.Has(key)) return nullptr;
   const std::string w = where + "." + key;
   const tinygltf::Value& info = ext.Get(key);
@@ -147,7 +146,7 @@ GltfSurface GltfMaterialReader::convert(int index, bool vertexColors) {
     if (ext->Has("transmissionTexture")) {
       const tinygltf::Value& info = ext->Get("transmissionTexture");
       (void)info;
-      in.transmission = extensionTexture(*ext, "transmissionTexture", Channels::Red, Color(factor), w, out);
+      in.transmission = extensionTexture(*ext, "transmissionTexture", Channels::Red, Color(factor), w);
     }
     if (!in.transmission && factor > 0.0f) in.transmission = std::make_shared<ConstantTexture>(Color(factor));
   }
@@ -164,9 +163,9 @@ GltfSurface GltfMaterialReader::convert(int index, bool vertexColors) {
     const float factor = numberOr(*ext, "specularFactor", 1.0f);
     if (!(factor >= 0.0f && factor <= 1.0f)) fail(w + ".specularFactor", "expected a number in [0, 1]");
     const Color color = colorFactor(*ext, "specularColorFactor", Color(1.0f), w, 1e38f, failAt);
-    in.specular = extensionTexture(*ext, "specularTexture", Channels::Alpha, Color(factor), w, out);
+    in.specular = extensionTexture(*ext, "specularTexture", Channels::Alpha, Color(factor), w);
     if (!in.specular && factor != 1.0f) in.specular = std::make_shared<ConstantTexture>(Color(factor));
-    in.specularColor = extensionTexture(*ext, "specularColorTexture", Channels::SrgbRgb, color, w, out);
+    in.specularColor = extensionTexture(*ext, "specularColorTexture", Channels::SrgbRgb, color, w);
     if (!in.specularColor && color != Color(1.0f))
       in.specularColor = std::make_shared<ConstantTexture>(color);
   }
@@ -177,10 +176,9 @@ GltfSurface GltfMaterialReader::convert(int index, bool vertexColors) {
     const float roughness = numberOr(*ext, "sheenRoughnessFactor", 0.0f);
     if (!(roughness >= 0.0f && roughness <= 1.0f))
       fail(w + ".sheenRoughnessFactor", "expected a number in [0, 1]");
-    in.sheenColor = extensionTexture(*ext, "sheenColorTexture", Channels::SrgbRgb, color, w, out);
+    in.sheenColor = extensionTexture(*ext, "sheenColorTexture", Channels::SrgbRgb, color, w);
     if (!in.sheenColor && !isBlack(color)) in.sheenColor = std::make_shared<ConstantTexture>(color);
-    in.sheenRoughness =
-        extensionTexture(*ext, "sheenRoughnessTexture", Channels::Alpha, Color(roughness), w, out);
+    in.sheenRoughness = extensionTexture(*ext, "sheenRoughnessTexture", Channels::Alpha, Color(roughness), w);
     if (!in.sheenRoughness) in.sheenRoughness = std::make_shared<ConstantTexture>(Color(roughness));
   }
   // KHR_materials_iridescence: weight (R), thickness (G) between the minimum and maximum, the
@@ -197,10 +195,10 @@ GltfSurface GltfMaterialReader::convert(int index, bool vertexColors) {
     for (const auto& [key, value] : {std::pair{"iridescenceThicknessMinimum", in.iridescenceThicknessMin},
                                      std::pair{"iridescenceThicknessMaximum", in.iridescenceThicknessMax}})
       if (!(value >= 0.0f && value < 1e6f)) fail(w + "." + key, "expected a thickness >= 0 (nm)");
-    in.iridescence = extensionTexture(*ext, "iridescenceTexture", Channels::Red, Color(factor), w, out);
+    in.iridescence = extensionTexture(*ext, "iridescenceTexture", Channels::Red, Color(factor), w);
     if (!in.iridescence && factor > 0.0f) in.iridescence = std::make_shared<ConstantTexture>(Color(factor));
     in.iridescenceThickness =
-        extensionTexture(*ext, "iridescenceThicknessTexture", Channels::Green, Color(1.0f), w, out);
+        extensionTexture(*ext, "iridescenceThicknessTexture", Channels::Green, Color(1.0f), w);
   }
   // KHR_materials_anisotropy: strength, rotation, and a texture of direction (RG) and strength (B).
   if (const tinygltf::Value* ext = extension(m.extensions, "KHR_materials_anisotropy")) {
@@ -210,7 +208,7 @@ GltfSurface GltfMaterialReader::convert(int index, bool vertexColors) {
       fail(w + ".anisotropyStrength", "expected a number in [0, 1]");
     in.anisotropyRotation = numberOr(*ext, "anisotropyRotation", 0.0f);
     if (!std::isfinite(in.anisotropyRotation)) fail(w + ".anisotropyRotation", "expected a number (radians)");
-    in.anisotropy = extensionTexture(*ext, "anisotropyTexture", Channels::LinearRgb, Color(1.0f), w, out);
+    in.anisotropy = extensionTexture(*ext, "anisotropyTexture", Channels::LinearRgb, Color(1.0f), w);
     // The direction lives in the mesh's tangent frame: meshes without TANGENT get generated ones.
     out.needsTangents = out.needsTangents || in.anisotropyStrength > 0.0f;
   }
@@ -222,13 +220,13 @@ GltfSurface GltfMaterialReader::convert(int index, bool vertexColors) {
     const float roughness = numberOr(*ext, "clearcoatRoughnessFactor", 0.0f);
     if (!(roughness >= 0.0f && roughness <= 1.0f))
       fail(w + ".clearcoatRoughnessFactor", "expected a number in [0, 1]");
-    in.clearcoat = extensionTexture(*ext, "clearcoatTexture", Channels::Red, Color(factor), w, out);
+    in.clearcoat = extensionTexture(*ext, "clearcoatTexture", Channels::Red, Color(factor), w);
     if (!in.clearcoat && factor > 0.0f) in.clearcoat = std::make_shared<ConstantTexture>(Color(factor));
     in.clearcoatRoughness =
-        extensionTexture(*ext, "clearcoatRoughnessTexture", Channels::Green, Color(roughness), w, out);
+        extensionTexture(*ext, "clearcoatRoughnessTexture", Channels::Green, Color(roughness), w);
     if (!in.clearcoatRoughness) in.clearcoatRoughness = std::make_shared<ConstantTexture>(Color(roughness));
     in.clearcoatNormal = extensionTexture(*ext, "clearcoatNormalTexture", Channels::LinearRgb, Color(1.0f), w,
-                                          out, &in.clearcoatNormalScale);
+                                          &in.clearcoatNormalScale);
     out.needsTangents = out.needsTangents || in.clearcoatNormal != nullptr;
   }
   if (const tinygltf::Value* ext = extension(m.extensions, "KHR_materials_volume")) {

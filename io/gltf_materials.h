@@ -48,8 +48,7 @@ class GltfMaterialReader {
   // The textureInfo `key` of an extension object (a plain JSON value), or null without one.
   std::shared_ptr<const Texture> extensionTexture(const tinygltf::Value& ext, const char* key,
                                                   Channels channels, const Color& scale,
-                                                  const std::string& where, GltfSurface& out,
-                                                  float* normalScale = nullptr);
+                                                  const std::string& where, float* normalScale = nullptr);
   std::shared_ptr<const Texture> texture(const tinygltf::TextureInfo& info, Channels channels,
                                          const Color& scale, const std::string& where);
   std::shared_ptr<const Texture> texture(int index, int texCoord, const tinygltf::ExtensionMap& extensions,

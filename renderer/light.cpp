@@ -175,7 +175,7 @@ bool TriangleLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
       at.attributes = mesh_;
       at.prim = prim_;
       at.bary = b;
-      out.Li *= texture_->evalAt(at);
+      out.Li *= texture_->evalFresh(at);
     }
     // Cut-out (MASK) or partly transparent (BLEND) parts emit as much as rays that hit them find.
     if (mesh_->opacity) out.Li *= mesh_->opacity->coverage(*mesh_, prim_, b);
