@@ -1,5 +1,5 @@
 // Light sampling of many reference points at once (next-event estimation for a whole bounce of a
-// wave, packet/wavefront_integrator.h). A shape's solid-angle sampling runs over up to kMaxLanes
+// wave, packet/wave_integrator.h). A shape's solid-angle sampling runs over up to kMaxLanes
 // lanes in Highway vectors (16 floats per AVX-512 register; the widest ISA the CPU has is picked at
 // run time). The scalar Shape::sampleSolidAngle of a shape with a lane kernel calls the same kernel
 // with one live lane, and a lane's result never depends on the other lanes: one ray or a packet,

@@ -4,7 +4,7 @@
 
 #include "io/input_error.h"
 #include "io/scene_loader.h"
-#include "packet/wavefront_integrator.h"
+#include "packet/wave_integrator.h"
 #include "renderer/path_phases.h"
 #include "renderer/render.h"
 
@@ -67,7 +67,7 @@ struct BenchArgs {
   int threads = 0;
   int repeat = 3;
   std::string json;
-  std::string kernel = "lanes";
+  std::string kernel = "wave";
   std::string packetWidth = "auto";
   bool phases = false;
   std::string caustics;  // "trace", "path", or empty: each scene's render.caustic_tracing
@@ -200,9 +200,8 @@ Runner addBenchCommand(CLI::App& app) {
       ->check(CLI::Range(1, 4096));
   cmd->add_option("--repeat", args->repeat, "Renders per scene; the median is reported (default 3)")
       ->check(CLI::Range(1, 1000));
-  cmd->add_option("--kernel", args->kernel,
-                  "lanes (default), wavefront, stream or scalar; see `ember render --help`")
-      ->check(CLI::IsMember({"wavefront", "stream", "scalar", "lanes"}));
+  cmd->add_option("--kernel", args->kernel, "wave (default) or scalar; see `ember render --help`")
+      ->check(CLI::IsMember({"wave", "scalar", "lanes", "wavefront"}));
   cmd->add_option("--packet-width", args->packetWidth,
                   "auto (default), 8 or 16 rays per packet; see `ember render --help`")
       ->check(CLI::IsMember({"auto", "8", "16"}));

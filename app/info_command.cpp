@@ -1,7 +1,6 @@
 #include "app/commands.h"
 
 #include "io/scene_loader.h"
-#include "packet/lane_integrator.h"
 
 #include <map>
 #include <memory>
@@ -56,12 +55,6 @@ Runner addInfoCommand(CLI::App& app) {
         punctualLights, emitters, twoSidedEmitters, emissiveTriangles, twoSidedTriangles,
         scene.environment() ? "1" : "no");
     std::printf("strategy:   %s\n", std::string(strategyName(rs.strategy)).c_str());
-    const std::string uncovered = LaneIntegrator::uncovered(scene, rs.strategy);
-    if (uncovered.empty())
-      std::printf("kernel:     lanes (the default --kernel covers this scene)\n");
-    else
-      std::printf("kernel:     wavefront (the default --kernel lanes does not cover %s)\n",
-                  uncovered.c_str());
     const CausticTracer& caustics = scene.causticTracer();
     if (!rs.traceCaustics || !caustics.enabled())
       std::printf("caustics:   path-traced (%s)\n",

@@ -7,7 +7,7 @@
 #include "io/input_error.h"
 #include "io/scene_loader.h"
 #include "io/tonemap.h"
-#include "packet/wavefront_integrator.h"
+#include "packet/wave_integrator.h"
 #include "renderer/render.h"
 
 #include <unistd.h>
@@ -37,7 +37,7 @@ struct RenderArgs {
   std::string sampler;
   std::string strategy;
   std::string caustics;
-  std::string kernel = "lanes";
+  std::string kernel = "wave";
   std::string packetWidth = "auto";
   std::string env;
   std::optional<float> envStrength;
@@ -415,14 +415,13 @@ Runner addRenderCommand(CLI::App& app) {
       ->check(CLI::IsMember({"trace", "path"}));
   cmd->add_option(
          "--kernel", args->kernel,
-         "How paths are traced, all giving the same image: lanes (the default: Embree packets, the "
-         "bounce's state in arrays and vector kernels, on the scenes it covers (`ember info` says), the "
-         "wavefront elsewhere), wavefront (Embree packets, per-path shading), stream (Embree ray "
-         "streams) or scalar (one ray at a time, the reference)")
-      ->check(CLI::IsMember({"wavefront", "stream", "scalar", "lanes"}));
+         "How paths are traced, both giving the same image: wave (the default: a tile's paths advance "
+         "together, rays cast as Embree packets, the bounce's state in arrays and vector kernels) or "
+         "scalar (one ray at a time, the reference); lanes and wavefront are old names of wave")
+      ->check(CLI::IsMember({"wave", "scalar", "lanes", "wavefront"}));
   cmd->add_option(
          "--packet-width", args->packetWidth,
-         "Rays per packet of the wavefront and stream kernels: auto (the default: 16 where Embree "
+         "Rays per packet of the wave kernel: auto (the default: 16 where Embree "
          "traverses 16-ray packets natively, as with AVX-512, else 8), 8 or 16; the image is the same")
       ->check(CLI::IsMember({"auto", "8", "16"}));
   cmd->add_option("--env", args->env,

@@ -80,7 +80,7 @@ def main():
     ap.add_argument("--seeds", type=int, default=3, help="independent renders per cell; relMSE and time are averaged")
     ap.add_argument("--variants", nargs="*", default=["llvm_ad_rgb"])
     ap.add_argument("--samplers", nargs="*", default=["independent", "sobol"], help="Ember samplers to run")
-    ap.add_argument("--kernels", nargs="*", default=["lanes"], help="Ember kernels to run (--kernel)")
+    ap.add_argument("--kernels", nargs="*", default=["wave"], help="Ember kernels to run (--kernel)")
     ap.add_argument("--caustics", nargs="*", default=["trace"],
                     help="Ember caustics estimators to run (--caustics trace: light tracing, path: path tracing alone)")
     ap.add_argument("--threads", type=int, default=os.cpu_count())

@@ -170,11 +170,11 @@ int run(int argc, char** argv) {
       rtcOccluded16(valid, rtc, &ctx, &r);
     }
   });
-  // What the wavefront integrator does (packet/ray_batch.h): batches of rays (256 here; the
-  // integrator's waves are 1,024, which changes nothing for packets, traced one by one), copied in,
-  // traced as 16 packets or as one stream, hits read back.
-  auto batchRow = [&](const char* name, BatchTraversal traversal, bool shadow) {
-    row(name, [&, traversal, shadow](size_t lo, size_t hi) {
+  // What the wave driver does (packet/ray_batch.h): batches of rays (256 here; the driver's waves
+  // are 1,024, which changes nothing for packets, traced one by one), copied in, traced as
+  // packets, hits read back.
+  auto batchRow = [&](const char* name, bool shadow) {
+    row(name, [&, shadow](size_t lo, size_t hi) {
       ClosestHitBatch closest(256, scene.accel().packetWidth());
       ShadowBatch shadows(256, scene.accel().packetWidth());
       RawHit raw;
@@ -183,20 +183,18 @@ int run(int argc, char** argv) {
         if (shadow) {
           shadows.clear();
           for (size_t k = i; k < end; ++k) shadows.push(b.shadow[k], b.shadowMask[k]);
-          shadows.trace(scene.accel(), traversal);
+          shadows.trace(scene.accel());
         } else {
           closest.clear();
           for (size_t k = i; k < end; ++k) closest.push(b.closest[k], b.closestMask[k]);
-          closest.trace(scene.accel(), traversal);
+          closest.trace(scene.accel());
           for (size_t k = 0; k < closest.size(); ++k) closest.hit(k, raw);
         }
       }
     });
   };
-  batchRow("closest-hit, batch of packets", BatchTraversal::Packets, false);
-  batchRow("closest-hit, batch as a stream", BatchTraversal::Stream, false);
-  batchRow("shadow, batch of packets", BatchTraversal::Packets, true);
-  batchRow("shadow, batch as a stream", BatchTraversal::Stream, true);
+  batchRow("closest-hit, batch of packets", false);
+  batchRow("shadow, batch of packets", true);
   // The mix a path tracer casts: one closest-hit and one shadow ray per path vertex.
   row("vertex mix (1 closest + 1 shadow)", [&](size_t lo, size_t hi) {
     for (size_t i = lo; i < hi; ++i) {

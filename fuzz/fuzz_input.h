@@ -5,7 +5,7 @@
 #pragma once
 
 #include "io/input_error.h"
-#include "packet/wavefront_integrator.h"
+#include "packet/wave_integrator.h"
 #include "renderer/render.h"
 
 #include <unistd.h>
@@ -50,7 +50,7 @@ inline void buildAndRenderTiny(Scene& scene, int maxDepth) {
   scene.settings.maxDepth =
       scene.settings.maxDepth < 0 ? maxDepth : std::min(scene.settings.maxDepth, maxDepth);
   scene.build();
-  const auto integrator = makeIntegrator(scene.settings, Kernel::Lanes);  // the default kernel
+  const auto integrator = makeIntegrator(scene.settings, Kernel::Wave);  // the default kernel
   Film film(4, 4);
   RenderOptions options;
   options.spp = 1;

@@ -34,7 +34,7 @@ uint64_t newHitMemoOwner();
 template <typename Value, typename Tag>
 class HitMemo {
  public:
-  // WavefrontIntegrator::kWaveSize, which this layer cannot include; a mismatch only costs lookups.
+  // WaveIntegrator::kWaveSize, which this layer cannot include; a mismatch only costs lookups.
   static constexpr size_t kSlots = 1024;
 
   // compute(), or what it returned for the same owner and UV at this hit before. The reference

@@ -30,11 +30,14 @@ class Lambertian final : public Material {
   void sampleLanes(const SurfaceHit* const* hits, const Vec3* wo, const Vec2* u, const float* uLobe, size_t n,
                    BsdfSample* out, bool* ok) const override;
   bool readsUv() const override { return !constant_; }
+  // Lambertian about the shading normal, so the driver's form wherever that is the geometric one.
+  bool lambertianAt(const SurfaceHit& hit, Color& reflectance) const override {
+    if (hit.ns != hit.ng) return false;
+    reflectance = reflectanceAt(hit);
+    return true;
+  }
   // The reflectance where it is the same everywhere; null where a texture varies it.
-  const Color* constantReflectance() const { return constant_ ? &constantValue_ : nullptr; }
-  // The reflectance at texture coordinates uv: what every method reads at a hit with that uv
-  // (Texture::evalAt is a function of the hit's uv alone).
-  Color reflectanceAt(Vec2 uv) const { return constant_ ? constantValue_ : reflectance_->eval(uv); }
+  const Color* uniformLambertian() const override { return constant_ ? &constantValue_ : nullptr; }
 
  private:
   bool absorbsEverythingAt(const SurfaceHit& hit) const override { return isBlack(reflectanceAt(hit)); }

@@ -42,6 +42,17 @@ class Material {
     for (size_t i = 0; i < n; ++i) ok[i] = sample(*hits[i], wo[i], u[i], uLobe[i], out[i]);
   }
 
+  // The batched driver's vector kernels (packet/next_event_lanes.h, continuation_lanes.h) evaluate
+  // and follow one BSDF inline: a Lambertian reflector shaded with the geometric normal, with its
+  // reflectance in a row. A material that is exactly that at `hit` says so and gives the
+  // reflectance; every other vertex is evaluated and sampled by its material's own methods. The
+  // answer is a fact about the BSDF, not a speed switch: the image is the same either way.
+  virtual bool lambertianAt(const SurfaceHit& /*hit*/, Color& /*reflectance*/) const { return false; }
+  // The same for every hit on an analytic shape (whose shading normal is its geometric normal),
+  // where the reflectance is also the same everywhere: the driver then settles a whole run of such
+  // hits in one kernel (packet/arrival_lanes.h). Null otherwise.
+  virtual const Color* uniformLambertian() const { return nullptr; }
+
   // Whether eval can be non-zero, i.e. light sampling is worth a shadow ray. A flag each material
   // sets where it is made: the bounce asks at every vertex.
   bool hasNonDeltaLobes() const { return nonDeltaLobes_; }

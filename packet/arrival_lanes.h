@@ -1,5 +1,5 @@
 // The arrival of a run of paths at one Lambertian shape with a constant reflectance
-// (packet/lane_integrator.h): the part of PathIntegrator::arrive and Scene::surfaceHit that such a
+// (packet/wave_integrator.h): the part of PathIntegrator::arrive and Scene::surfaceHit that such a
 // vertex needs, for a whole run in Highway vectors. Each lane gathers its path's ray and state
 // from the paths' rows by slot and its hit from the batch's packets, and the run's vertices are
 // stored consecutively, as whole vectors, into the vertex rows.

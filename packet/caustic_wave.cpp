@@ -56,8 +56,7 @@ struct LightWave {
 }  // namespace
 
 void traceCausticsInWaves(const Scene& scene, int maxDepth, int rrDepth, uint64_t seed, SamplerType type,
-                          uint64_t firstIndex, int count, CausticSplats& splats, PathStats& stats,
-                          BatchTraversal traversal) {
+                          uint64_t firstIndex, int count, CausticSplats& splats, PathStats& stats) {
   const CausticTracer& tracer = scene.causticTracer();
   if (!tracer.enabled() || count <= 0 || !CausticTracer::reachesCaustics(maxDepth)) return;
   // Plain variables, not a structured binding: Clang 14 cannot capture those in the lambda.
@@ -100,7 +99,7 @@ void traceCausticsInWaves(const Scene& scene, int maxDepth, int rrDepth, uint64_
         }
         while (active > 0) {
           local.rays += active;
-          traceTimed(wave.closest, scene.accel(), traversal, local);
+          traceTimed(wave.closest, scene.accel(), local);
           // CausticTracer::onHit in its steps, each for the whole bounce: arrival and the camera
           // connections, then the BSDFs' numbers and samples, then the next rays.
           wave.shadows.clear();
@@ -141,7 +140,7 @@ void traceCausticsInWaves(const Scene& scene, int maxDepth, int rrDepth, uint64_
             }
           }
           local.shadowRays += wave.shadows.size();
-          traceTimed(wave.shadows, scene.accel(), traversal, local);
+          traceTimed(wave.shadows, scene.accel(), local);
           for (size_t j = 0; j < wave.shadows.size(); ++j)
             if (!wave.shadows.occluded(j) &&
                 !splats.add(wave.splatImage[j], wave.splats[j].x, wave.splats[j].y, wave.splats[j].value))

@@ -1,4 +1,4 @@
-// The continuation of a whole bounce's vertices at once (packet/lane_integrator.h):
+// The continuation of a whole bounce's vertices at once (packet/wave_integrator.h):
 // PathIntegrator::followBsdfSample for every vertex in Highway vectors (16 floats per AVX-512
 // register): the throughput times the BSDF sample's weight, the side the next ray leaves to and its
 // origin pushed off the surface, the eta product, Russian roulette, and the surviving paths written

@@ -31,7 +31,8 @@ HWY_INLINE V powerHeuristic(D d, V a, V b) {
   return hn::IfThenElseZero(hn::Gt(a, zero), w);
 }
 
-size_t NextEventKernel(NextEventArrays& a, const uint32_t* maskFront, const uint32_t* maskBack, size_t n) {
+size_t NextEventKernel(NextEventArrays& a, const uint32_t* maskFront, const uint32_t* maskBack, size_t n,
+                       bool misWeights) {
   const D d;
   const V zero = hn::Zero(d);
   size_t shadows = 0;
@@ -108,7 +109,8 @@ size_t NextEventKernel(NextEventArrays& a, const uint32_t* maskFront, const uint
 
     // The contribution, throughput * (f * Li * (weight / lightPdf)).
     const V pdf = hn::Mul(load(a.pmf), lightPdf);
-    const V weight = hn::IfThenElse(delta, hn::Set(d, 1.0f), powerHeuristic(d, pdf, bsdfPdf));
+    const V weight = misWeights ? hn::IfThenElse(delta, hn::Set(d, 1.0f), powerHeuristic(d, pdf, bsdfPdf))
+                                : hn::Set(d, 1.0f);
     const V k = hn::Div(weight, pdf);
     for (int c = 0; c < 3; ++c)
       hn::Store(hn::Mul(tp[c], hn::Mul(hn::Mul(f[c], li[c]), k)), d, a.contribution[c] + i);
@@ -150,8 +152,9 @@ namespace ember {
 
 HWY_EXPORT(NextEventKernel);
 
-size_t nextEventLanes(NextEventArrays& a, const uint32_t* maskFront, const uint32_t* maskBack, size_t n) {
-  return HWY_DYNAMIC_DISPATCH(NextEventKernel)(a, maskFront, maskBack, n);
+size_t nextEventLanes(NextEventArrays& a, const uint32_t* maskFront, const uint32_t* maskBack, size_t n,
+                      bool misWeights) {
+  return HWY_DYNAMIC_DISPATCH(NextEventKernel)(a, maskFront, maskBack, n, misWeights);
 }
 
 }  // namespace ember

@@ -1,4 +1,4 @@
-// Next-event estimation for a whole bounce of Lambertian vertices at once (packet/lane_integrator.h):
+// Next-event estimation for a whole bounce of Lambertian vertices at once (packet/wave_integrator.h):
 // PathIntegrator::shadowFor with Lambertian::evalPdf, spawnRayTo, SurfaceHit::maskToward and the
 // power heuristic, for every vertex in Highway vectors (16 floats per AVX-512 register; the widest
 // ISA the CPU has is picked at run time). Each lane takes the scalar code's float operations in
@@ -65,6 +65,9 @@ struct NextEventArrays {
 // (SurfaceHit::maskFor), 64-byte aligned rows readable up to the next multiple of kBlock past n.
 // The compacted rows' lanes past the count hold leftovers of the compression; the batches copy
 // them into the last packet's unused lanes, which ShadowBatch::trace then makes inactive.
-size_t nextEventLanes(NextEventArrays& a, const uint32_t* maskFront, const uint32_t* maskBack, size_t n);
+// misWeights: the power heuristic against the BSDF's density (strategy mis); off, every light
+// sample has weight 1 (strategy light).
+size_t nextEventLanes(NextEventArrays& a, const uint32_t* maskFront, const uint32_t* maskBack, size_t n,
+                      bool misWeights);
 
 }  // namespace ember

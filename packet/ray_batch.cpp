@@ -60,11 +60,10 @@ void validMask(int (&valid)[kMaxWidth], size_t count) {
   for (size_t i = 0; i < kMaxWidth; ++i) valid[i] = i < count ? -1 : 0;
 }
 
-// Stream calls have no valid mask, and where Embree splits a packet wider than its own it looks
-// past the mask too: so the unused lanes of the last packet always get the valid, empty interval
-// (1, 0) at the origin: the InactiveRay (packet/traceable_lanes.h). (Left as they were, they held
-// whatever the storage held: an uninitialised lane tripped Embree's assertion that every active
-// ray is valid.)
+// Where Embree splits a packet wider than its own it looks past the valid mask: so the unused lanes of the
+// last packet always get the valid, empty interval (1, 0) at the origin: the InactiveRay
+// (packet/traceable_lanes.h). (Left as they were, they held whatever the storage held: an uninitialised lane
+// tripped Embree's assertion that every active ray is valid.)
 void disableLanes(RTCRayN* p, unsigned n, size_t from) {
   for (size_t i = from; i < n; ++i) {
     RTCRayN_org_x(p, n, unsigned(i)) = InactiveRay::kOrigin;
@@ -174,7 +173,7 @@ void ClosestHitBatch::assign(const std::array<const float*, 3>& origin,
   size_ = count;
 }
 
-void ClosestHitBatch::trace(const EmbreeAccel& accel, BatchTraversal traversal) {
+void ClosestHitBatch::trace(const EmbreeAccel& accel) {
   if (size_ == 0) return;
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
@@ -183,12 +182,6 @@ void ClosestHitBatch::trace(const EmbreeAccel& accel, BatchTraversal traversal) 
   auto* last = reinterpret_cast<RTCRayHitN*>(storage_.packet(packets - 1));
   disableLanes(RTCRayHitN_RayN(last, n), n, size_ - (packets - 1) * n);
   disableUntraceableRays(storage_.packet(0), packets, n * kFloatsPerRayHit, n);
-  if (traversal == BatchTraversal::Stream) {
-    context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
-    rtcIntersectNM(accel.rtcScene(), &context, reinterpret_cast<RTCRayHitN*>(storage_.packet(0)), n, packets,
-                   n * kFloatsPerRayHit * sizeof(float));
-    return;
-  }
   alignas(64) int valid[kMaxWidth];
   for (size_t k = 0; k < packets; ++k) {
     validMask(valid, std::min<size_t>(n, size_ - k * n));
@@ -251,7 +244,7 @@ void ShadowBatch::assign(const std::array<const float*, 3>& origin, const std::a
   size_ = count;
 }
 
-void ShadowBatch::trace(const EmbreeAccel& accel, BatchTraversal traversal) {
+void ShadowBatch::trace(const EmbreeAccel& accel) {
   if (size_ == 0) return;
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
@@ -259,12 +252,6 @@ void ShadowBatch::trace(const EmbreeAccel& accel, BatchTraversal traversal) {
   const size_t packets = storage_.packets(size_);
   disableLanes(reinterpret_cast<RTCRayN*>(storage_.packet(packets - 1)), n, size_ - (packets - 1) * n);
   disableUntraceableRays(storage_.packet(0), packets, n * kFloatsPerRay, n);
-  if (traversal == BatchTraversal::Stream) {
-    context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
-    rtcOccludedNM(accel.rtcScene(), &context, reinterpret_cast<RTCRayN*>(storage_.packet(0)), n, packets,
-                  n * kFloatsPerRay * sizeof(float));
-    return;
-  }
   alignas(64) int valid[kMaxWidth];
   for (size_t k = 0; k < packets; ++k) {
     validMask(valid, std::min<size_t>(n, size_ - k * n));

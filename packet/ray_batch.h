@@ -1,8 +1,7 @@
 // Rays cast together: up to `capacity` rays stored as Embree packets of `width` rays (8 or 16:
 // structure of arrays, lane i % width of packet i / width), traced by one call per packet
-// (rtcIntersect8/16, rtcOccluded8/16) or by one stream call over all packets (rtcIntersectNM /
-// rtcOccludedNM). Embree then tests each BVH node against a whole packet, and our user-geometry
-// callbacks get the packet's rays in one call (accel/user_geometry.cpp), which they intersect
+// (rtcIntersect8/16, rtcOccluded8/16). Embree then tests each BVH node against a whole packet, and our
+// user-geometry callbacks get the packet's rays in one call (accel/user_geometry.cpp), which they intersect
 // together (accel/shape_lanes.h). The width should be the one Embree traverses natively
 // (EmbreeAccel::packetWidth): a packet of any other width Embree splits and copies into its own,
 // and calls the callbacks with those.
@@ -20,9 +19,6 @@
 #include <memory>
 
 namespace ember {
-
-// How a batch is handed to Embree; measured in docs/performance.md.
-enum class BatchTraversal { Packets, Stream };
 
 namespace detail {
 
@@ -87,7 +83,7 @@ class ClosestHitBatch {
   // next multiple of the width past count (packet/packet_fields.h).
   void assign(const std::array<const float*, 3>& origin, const std::array<const float*, 3>& dir,
               const uint32_t* mask, size_t count);
-  void trace(const EmbreeAccel& accel, BatchTraversal traversal = BatchTraversal::Packets);
+  void trace(const EmbreeAccel& accel);
   // The closest hit of ray i, as EmbreeAccel::intersect reports it; false if it hit nothing.
   bool hit(size_t i, RawHit& out) const;
   // The layout hit() reads, valid until the next setWidth.
@@ -129,7 +125,7 @@ class ShadowBatch {
   // origin's, along dir's, over (0, tMax[i]), with Embree mask mask[i], as push makes it.
   void assign(const std::array<const float*, 3>& origin, const std::array<const float*, 3>& dir,
               const float* tMax, const uint32_t* mask, size_t count);
-  void trace(const EmbreeAccel& accel, BatchTraversal traversal = BatchTraversal::Packets);
+  void trace(const EmbreeAccel& accel);
   bool occluded(size_t i) const {
     return RTCRayN_tfar(reinterpret_cast<RTCRayN*>(storage_.packetOf(i)), storage_.width(),
                         storage_.laneOf(i)) < 0.0f;

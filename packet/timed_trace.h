@@ -14,9 +14,9 @@
 namespace ember {
 
 template <class Batch>
-void traceTimed(Batch& batch, const EmbreeAccel& accel, BatchTraversal traversal, PathStats& stats) {
+void traceTimed(Batch& batch, const EmbreeAccel& accel, PathStats& stats) {
   const std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
-  batch.trace(accel, traversal);
+  batch.trace(accel);
   stats.traceNanoseconds += nanosecondsBetween(start, std::chrono::steady_clock::now());
 }
 

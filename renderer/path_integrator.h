@@ -79,7 +79,7 @@ class PathIntegrator final : public Integrator {
   Color Li(const Scene& scene, Ray ray, Sampler& sampler, PathStats& stats) const override;
 
   // The path as a state machine, for Li and for loops that cast the rays of many paths together
-  // (packet/wavefront_integrator.h). Both call the same steps in the same order per path, so
+  // (packet/wave_integrator.h). Both call the same steps in the same order per path, so
   // they estimate the same value bit for bit.
   // A path starting with a camera ray; false if it can carry no light (max depth 0).
   bool start(const Ray& cameraRay, PathState& path) const;

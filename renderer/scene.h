@@ -118,7 +118,7 @@ class Scene {
   size_t triangleCount() const;
 
   // What surfaceHit knows of a geometry (Embree geomID) before it is hit: for loops that settle
-  // hits in their own form (packet/lane_integrator.h).
+  // hits in their own form (packet/wave_integrator.h).
   struct GeometryRecord {
     const Shape* shape = nullptr;
     const TriangleMesh* mesh = nullptr;

@@ -58,7 +58,7 @@ TEST(BenchCommand, JsonReportsTheBuildAndTheRates) {
 // a part of the render and never all of it; the scalar kernel, one ray per call, times none.
 TEST(BenchCommand, TraceShareComesFromTheBatchedKernels) {
   test::TempDir dir;
-  for (const std::string kernel : {"wavefront", "stream", "scalar"}) {
+  for (const std::string kernel : {"wave", "scalar"}) {
     const nlohmann::json scene = benchCornellPoint(dir, kernel + ".json", "--spp 2 --kernel " + kernel);
     const double seconds = scene.at("trace_seconds"), share = scene.at("trace_share");
     if (kernel == "scalar") {

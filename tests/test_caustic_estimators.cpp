@@ -8,7 +8,7 @@
 // and every strategy. A last case double-counts the caustics on purpose and must be rejected.
 #include "io/image_compare.h"
 #include "io/scene_loader.h"
-#include "packet/wavefront_integrator.h"
+#include "packet/wave_integrator.h"
 #include "renderer/render.h"
 
 #include <gtest/gtest.h>
@@ -89,9 +89,9 @@ Pair renderBoth(Scene& scene) {
   scene.settings.traceCaustics = true;
   scene.build();
   EXPECT_TRUE(scene.causticTracer().enabled());
-  Film traced = render(scene, *makeIntegrator(scene.settings, Kernel::Wavefront), 11);
+  Film traced = render(scene, *makeIntegrator(scene.settings, Kernel::Wave), 11);
   scene.settings.traceCaustics = false;
-  Film alone = render(scene, *makeIntegrator(scene.settings, Kernel::Wavefront), 12);
+  Film alone = render(scene, *makeIntegrator(scene.settings, Kernel::Wave), 12);
   return {std::move(traced), std::move(alone)};
 }
 
@@ -181,9 +181,9 @@ TEST(CausticEstimators, DoubleCountedCausticsAreRejected) {
   Scene scene = load(sceneJson(kMirrorMaterial + kGlassMaterial, kMirrorShape + kGlassShape, -1), "double");
   scene.settings.traceCaustics = false;  // the inner path tracer keeps every path
   scene.build();
-  const std::unique_ptr<Integrator> pathOnly = makeIntegrator(scene.settings, Kernel::Wavefront);
+  const std::unique_ptr<Integrator> pathOnly = makeIntegrator(scene.settings, Kernel::Wave);
   const Film twice = render(scene, DoubleCounting(*pathOnly), 11);
-  const Film alone = render(scene, *makeIntegrator(scene.settings, Kernel::Wavefront), 12);
+  const Film alone = render(scene, *makeIntegrator(scene.settings, Kernel::Wave), 12);
   const BlockZTestResult r = compare(twice, alone);
   EXPECT_FALSE(r.passes());
   EXPECT_GT(r.failures, r.tests / 10) << "caustics should be visible in many blocks";

@@ -3,7 +3,7 @@
 // its connections use, and renders that stay bit-identical for any kernel, thread count and pass
 // size with light tracing on. Its estimates are tested in test_caustic_estimators.cpp.
 #include "io/scene_loader.h"
-#include "packet/wavefront_integrator.h"
+#include "packet/wave_integrator.h"
 #include "renderer/render.h"
 
 #include <gtest/gtest.h>
@@ -133,10 +133,9 @@ TEST(CausticTracer, SameImageForAnyKernelThreadsAndPassSize) {
   ASSERT_TRUE(scene.causticTracer().enabled());
   PathStats withLight;
   const Film reference = renderWith(scene, Kernel::Scalar, 1, 6, 4, &withLight);
-  EXPECT_TRUE(identical(reference, renderWith(scene, Kernel::Wavefront, 2, 6, 4))) << "wavefront";
-  EXPECT_TRUE(identical(reference, renderWith(scene, Kernel::Stream, 2, 6, 4))) << "stream";
-  EXPECT_TRUE(identical(reference, renderWith(scene, Kernel::Wavefront, 1, 6, 1))) << "pass size 1";
-  EXPECT_TRUE(identical(reference, renderWith(scene, Kernel::Wavefront, 2, 6, 6))) << "one pass";
+  EXPECT_TRUE(identical(reference, renderWith(scene, Kernel::Wave, 2, 6, 4))) << "wave";
+  EXPECT_TRUE(identical(reference, renderWith(scene, Kernel::Wave, 1, 6, 1))) << "pass size 1";
+  EXPECT_TRUE(identical(reference, renderWith(scene, Kernel::Wave, 2, 6, 6))) << "one pass";
 
   Scene off = loadScene(test::sourcePath("scenes/cornell-area.json"));
   off.settings.width = 37;
@@ -144,7 +143,7 @@ TEST(CausticTracer, SameImageForAnyKernelThreadsAndPassSize) {
   off.settings.traceCaustics = false;
   off.build();
   PathStats pathOnly;
-  const Film without = renderWith(off, Kernel::Wavefront, 2, 6, 4, &pathOnly);
+  const Film without = renderWith(off, Kernel::Wave, 2, 6, 4, &pathOnly);
   EXPECT_FALSE(identical(reference, without));
   EXPECT_GT(withLight.rays, pathOnly.rays);  // the light paths' rays are counted too
   EXPECT_GT(withLight.shadowRays, pathOnly.shadowRays);
@@ -167,7 +166,7 @@ TEST(CausticTracer, SameImageForAnyKernelAtShortDepthsAndWithEverySampler) {
       const std::string what = std::string(sampler == SamplerType::Sobol ? "sobol" : "independent") +
                                ", max depth " + std::to_string(maxDepth);
       const Film reference = renderWith(scene, Kernel::Scalar, 1, 4, 2);
-      EXPECT_TRUE(identical(reference, renderWith(scene, Kernel::Wavefront, 2, 4, 2))) << what;
+      EXPECT_TRUE(identical(reference, renderWith(scene, Kernel::Wave, 2, 4, 2))) << what;
     }
   }
 }

@@ -6,7 +6,7 @@
 #include "io/input_error.h"
 #include "io/pending_file.h"
 #include "io/scene_loader.h"
-#include "packet/wavefront_integrator.h"
+#include "packet/wave_integrator.h"
 #include "renderer/render.h"
 
 #include <gtest/gtest.h>
@@ -75,7 +75,7 @@ class StopAfterTiles final : public test::ForwardingIntegrator {
 
 TEST(Passes, AnyPassSizeGivesTheSameFilm) {
   const Scene scene = smallScene();
-  const auto integrator = makeIntegrator(scene.settings, Kernel::Wavefront);
+  const auto integrator = makeIntegrator(scene.settings, Kernel::Wave);
   Film one(40, 40), passes(40, 40), odd(40, 40);
   render(scene, *integrator, optionsFor(scene, 10, 1000), one);
   const RenderStats st = render(scene, *integrator, optionsFor(scene, 10, 3), passes);
@@ -88,7 +88,7 @@ TEST(Passes, AnyPassSizeGivesTheSameFilm) {
 
 TEST(Passes, AnInterruptedPassIsTakenBackAndResumingEndsBitIdentical) {
   const Scene scene = smallScene();
-  const auto integrator = makeIntegrator(scene.settings, Kernel::Wavefront);
+  const auto integrator = makeIntegrator(scene.settings, Kernel::Wave);
   Film reference(40, 40);
   render(scene, *integrator, optionsFor(scene, 12, 4), reference);
   Film afterOnePass(40, 40);
@@ -116,7 +116,7 @@ TEST(Passes, AnInterruptedPassIsTakenBackAndResumingEndsBitIdentical) {
 
 TEST(Passes, TimeBudgetStopsBeforeAPassThatWouldNotFit) {
   const Scene scene = smallScene(64);
-  const auto integrator = makeIntegrator(scene.settings, Kernel::Wavefront);
+  const auto integrator = makeIntegrator(scene.settings, Kernel::Wave);
   Film film(64, 64);
   RenderOptions o = optionsFor(scene, 100000, 4);
   o.timeBudgetSeconds = 0.3;
@@ -134,7 +134,7 @@ TEST(Passes, TimeBudgetStopsBeforeAPassThatWouldNotFit) {
 
 Checkpoint sampleCheckpoint() {
   const Scene scene = smallScene(12);
-  const auto integrator = makeIntegrator(scene.settings, Kernel::Wavefront);
+  const auto integrator = makeIntegrator(scene.settings, Kernel::Wave);
   Checkpoint c;
   c.identity = identityOf(scene, test::sourcePath("scenes/cornell-area.json"), -1, "", "");
   c.spp = 8;

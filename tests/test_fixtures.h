@@ -1,7 +1,7 @@
 // Small helpers several test files share: a flat shading point and a whole-scene render.
 #pragma once
 
-#include "packet/wavefront_integrator.h"
+#include "packet/wave_integrator.h"
 #include "renderer/render.h"
 #include "renderer/scene.h"
 
@@ -44,7 +44,7 @@ class ForwardingIntegrator : public Integrator {
 // uses by default (tests/test_wavefront.cpp holds it equal to the scalar reference).
 inline Film renderFilm(const Scene& scene, int spp, uint64_t seed, RenderStats* stats = nullptr,
                        SamplerType sampler = SamplerType::Independent) {
-  const std::unique_ptr<Integrator> integrator = makeIntegrator(scene.settings, Kernel::Wavefront);
+  const std::unique_ptr<Integrator> integrator = makeIntegrator(scene.settings, Kernel::Wave);
   Film film(scene.settings.width, scene.settings.height);
   RenderOptions options;
   options.spp = spp;

@@ -2,7 +2,7 @@
 #include "io/input_error.h"
 #include "io/scene_loader.h"
 #include "materials/texture.h"
-#include "packet/wavefront_integrator.h"
+#include "packet/wave_integrator.h"
 #include "renderer/render.h"
 
 #include <gtest/gtest.h>
@@ -23,7 +23,7 @@ TEST(FuzzRegressions, HugeTextureCoordinatesLookUpATexel) {
   Scene scene = loadScene(test::sourcePath("tests/data/fuzz/huge-texture-uv.gltf"));
   scene.settings.width = scene.settings.height = 8;
   scene.build();
-  for (Kernel kernel : {Kernel::Scalar, Kernel::Wavefront}) {
+  for (Kernel kernel : {Kernel::Scalar, Kernel::Wave}) {
     const auto integrator = makeIntegrator(scene.settings, kernel);
     Film film(8, 8);
     RenderOptions options;
@@ -52,7 +52,7 @@ TEST(FuzzRegressions, UntraceableCameraRaysMissInsteadOfAbortingEmbree) {
   Scene scene = loadScene(test::sourcePath("tests/data/fuzz/untraceable-camera-rays.glb"));
   scene.settings.width = scene.settings.height = 8;
   scene.build();
-  for (Kernel kernel : {Kernel::Scalar, Kernel::Wavefront, Kernel::Stream}) {
+  for (Kernel kernel : {Kernel::Scalar, Kernel::Wave}) {
     const auto integrator = makeIntegrator(scene.settings, kernel);
     Film film(8, 8);
     RenderOptions options;

@@ -7,7 +7,7 @@
 #include "renderer/path_integrator.h"
 #include "renderer/render.h"
 
-#include "packet/wavefront_integrator.h"
+#include "packet/wave_integrator.h"
 
 #include <gtest/gtest.h>
 #include <tiny_gltf.h>
@@ -98,7 +98,7 @@ float renderAt(const TempDir& dir, const std::string& gltf, const Vec3& target, 
   Scene scene = loadScene(dir.write("s.json", json));
   scene.build();
   const PathIntegrator reference(2, 5);
-  const std::unique_ptr<Integrator> kernel = makeIntegrator(scene.settings, Kernel::Lanes);
+  const std::unique_ptr<Integrator> kernel = makeIntegrator(scene.settings, Kernel::Wave);
   Film film(1, 1);
   RenderOptions options;
   options.spp = 16;

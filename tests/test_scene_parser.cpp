@@ -201,21 +201,6 @@ TEST(CommandLine, InfoSaysHowCausticsAreEstimated) {
       << shapes.output;
 }
 
-// ember info says which kernel renders a scene by default, and what keeps the lane kernel from it.
-TEST(CommandLine, InfoSaysWhichKernelRendersTheScene) {
-  const auto shapes = test::runEmber("info '" + test::sourcePath("scenes/shapes.json") + "'");
-  EXPECT_NE(shapes.output.find("kernel:     lanes (the default --kernel covers this scene)"),
-            std::string::npos)
-      << shapes.output;
-  const auto demo = test::runEmber("info '" + test::sourcePath("scenes/demo.json") + "'");
-  EXPECT_NE(
-      demo.output.find("kernel:     wavefront (the default --kernel lanes does not cover a phong material)"),
-      std::string::npos)
-      << demo.output;
-  const auto gltf = test::runEmber("info '" + test::sourcePath("scenes/gltf-mixed.json") + "'");
-  EXPECT_NE(gltf.output.find("does not cover triangle meshes"), std::string::npos) << gltf.output;
-}
-
 // --strategy bsdf cannot reach the scene's point light, and says so; the others are silent.
 TEST(CommandLine, BsdfStrategyWarnsAboutUnreachableDeltaLights) {
   TempDir dir;

@@ -8,8 +8,7 @@
 #include "materials/phong.h"
 #include "materials/texture.h"
 #include "packet/geometry_groups.h"
-#include "packet/lane_integrator.h"
-#include "packet/wavefront_integrator.h"
+#include "packet/wave_integrator.h"
 #include "renderer/render.h"
 
 #include <gtest/gtest.h>
@@ -77,19 +76,15 @@ Scene loadSmall(const std::string& path, int width, int height) {
   return scene;
 }
 
-// The batched kernels at both packet widths (8: AVX2's native width, 16: AVX-512's), whatever
-// this machine's native width is. The lane kernel renders the scenes it covers and hands the others
-// to the wavefront kernel: the same image either way.
+// The wave driver at both packet widths (8: AVX2's native width, 16: AVX-512's), whatever this
+// machine's native width is, against the scalar reference.
 void expectKernelsAgree(Scene& scene, const std::string& name, const RenderCase& c = {}) {
   const Film reference = renderWith(scene, Kernel::Scalar, c);
   const unsigned native = scene.accel().packetWidth();
   for (const unsigned width : {16u, 8u}) {
     scene.setPacketWidth(width);
     const std::string packets = " (packets of " + std::to_string(width) + ")";
-    expectIdentical(reference, renderWith(scene, Kernel::Wavefront, c),
-                    name + ": wavefront vs scalar" + packets);
-    expectIdentical(reference, renderWith(scene, Kernel::Stream, c), name + ": stream vs scalar" + packets);
-    expectIdentical(reference, renderWith(scene, Kernel::Lanes, c), name + ": lanes vs scalar" + packets);
+    expectIdentical(reference, renderWith(scene, Kernel::Wave, c), name + ": wave vs scalar" + packets);
   }
   scene.setPacketWidth(native);
 }
@@ -168,21 +163,20 @@ TEST(Wavefront, SameImageAsScalarForEveryEmitterAndLight) {
 TEST(LaneKernel, SameImageAsScalarOnEverySimdTarget) {
   for (const char* name : {"terrace", "cornell-area"}) {
     Scene scene = loadSmall(test::sourcePath(std::string("scenes/") + name + ".json"), 21, 17);
-    ASSERT_TRUE(LaneIntegrator::covers(scene, Strategy::Mis)) << name;
     forEachSimdTarget([&] {
       expectIdentical(renderWith(scene, Kernel::Scalar, {2, 8, 2}),
-                      renderWith(scene, Kernel::Lanes, {2, 8, 2}), std::string(name) + ": lanes vs scalar");
+                      renderWith(scene, Kernel::Wave, {2, 8, 2}), std::string(name) + ": lanes vs scalar");
     });
   }
 }
 
-// An integrator decides once per scene whether the lane kernel covers it. A scene edited and built
-// again, at the same address, is a new scene: here one the lane kernel does not cover (a Phong
-// material), which the integrator must then hand to the wavefront kernel. (Keyed by the scene's
-// address, the decision was kept, and the lane kernel read the Phong material as a Lambertian.)
+// A scene edited and built again, at the same address, is a new scene: here its Lambertian
+// materials become Phong ones, which the driver must evaluate through the material's own methods,
+// not the kernels' Lambertian form. (When the driver decided per scene which scenes it covered,
+// keyed by the scene's address, it once kept the old answer and read Phong as Lambertian.)
 TEST(LaneKernel, DecidesAfreshForASceneBuiltAgain) {
   Scene scene = loadSmall(test::sourcePath("scenes/cornell-area.json"), 24, 20);
-  const std::unique_ptr<Integrator> lanes = makeIntegrator(scene.settings, Kernel::Lanes);
+  const std::unique_ptr<Integrator> lanes = makeIntegrator(scene.settings, Kernel::Wave);
   RenderOptions options;
   options.spp = 2;
   options.seed = scene.settings.seed;
@@ -194,18 +188,16 @@ TEST(LaneKernel, DecidesAfreshForASceneBuiltAgain) {
     render(scene, *lanes, options, film);
     return film;
   };
-  ASSERT_TRUE(LaneIntegrator::covers(scene, Strategy::Mis));
   expectIdentical(renderWith(scene, Kernel::Scalar, {2, 8, 2}), renderLanes(), "before the edit");
   const Material* phong = scene.addMaterial(
       "phong", std::make_unique<Phong>(std::make_shared<ConstantTexture>(Color(0.5f)), Color(0.3f), 20.0f));
   for (Scene::ShapeEntry& entry : scene.shapes)
     if (entry.material) entry.material = phong;
   scene.build();
-  ASSERT_FALSE(LaneIntegrator::covers(scene, Strategy::Mis));
   expectIdentical(renderWith(scene, Kernel::Scalar, {2, 8, 2}), renderLanes(), "after the edit and build()");
 }
 
-// The scenes the lane kernel covers (packet/lane_integrator.h), at the edges of its set: every
+// The scenes the lane kernel covers (packet/wave_integrator.h), at the edges of its set: every
 // analytic shape, a textured material, mirrors and glass (caustics path-traced or left to the
 // light tracer), emitters of every shape, one- and two-sided, facing in and out (a
 // sphere whose normals point inwards encloses the scene), point and spot lights, a black (absorbing)
@@ -248,7 +240,6 @@ TEST(LaneKernel, SameImageAsScalarOnTheScenesItCovers) {
   })";
   std::ofstream(path) << json;
   Scene scene = loadBuilt(path);  // a load error fails the test with its message
-  ASSERT_TRUE(LaneIntegrator::covers(scene, Strategy::Mis));
   for (SamplerType sampler : {SamplerType::Sobol, SamplerType::Independent})
     for (bool caustics : {true, false}) {
       scene.settings.sampler = sampler;
@@ -293,23 +284,18 @@ TEST(LaneKernel, SameImageAsScalarOnTheScenesItCovers) {
         replaced(open, R"("materials": {)", R"("environment": {"map": ")" + sky + R"("}, "materials": {)")}) {
     std::ofstream(path) << variant;
     Scene sunlit = loadBuilt(path);
-    ASSERT_TRUE(LaneIntegrator::covers(sunlit, Strategy::Mis));
     ASSERT_NE(sunlit.environment(), nullptr);
     expectKernelsAgree(sunlit, sunlit.environmentMap ? "sun and environment map" : "sun and background");
   }
-  // Outside the set: another strategy.
-  EXPECT_FALSE(LaneIntegrator::covers(scene, Strategy::Light));
-  scene.settings.strategy = Strategy::Light;
-  expectKernelsAgree(scene, "covered scene, strategy light");
+  // The other strategies, at bounded and unbounded depth (the vector arrival's runs).
+  for (Strategy strategy : {Strategy::Light, Strategy::Bsdf})
+    for (int maxDepth : {7, -1}) {
+      scene.settings.strategy = strategy;
+      scene.settings.maxDepth = maxDepth;
+      expectKernelsAgree(scene, "strategy " + std::string(strategyName(strategy)) + ", max depth " +
+                                    std::to_string(maxDepth));
+    }
   std::filesystem::remove(path);
-  for (const char* name : {"gltf-mixed", "demo", "courtyard"})
-    EXPECT_FALSE(LaneIntegrator::covers(
-        loadSmall(test::sourcePath(std::string("scenes/") + name + ".json"), 8, 8), Strategy::Mis))
-        << name;
-  for (const char* name : {"cornell-point", "cornell-area", "shapes", "textured", "terrace"})
-    EXPECT_TRUE(LaneIntegrator::covers(
-        loadSmall(test::sourcePath(std::string("scenes/") + name + ".json"), 8, 8), Strategy::Mis))
-        << name;
 }
 
 // More geometries than the counting sort's buckets pay for (packet/wavefront_integrator.cpp,
@@ -339,8 +325,7 @@ TEST(Wavefront, SameImageAsScalarWithThousandsOfGeometries) {
     f << "]}";
   }
   Scene scene = loadBuilt(path);  // a load error fails the test with its message
-  ASSERT_GT(scene.geometryCount() + 1, WavefrontIntegrator::kMaxCountingSortBuckets);
-  ASSERT_TRUE(LaneIntegrator::covers(scene, Strategy::Mis));
+  ASSERT_GT(scene.geometryCount() + 1, GeometryGroups::kMaxCountingSortBuckets);
   expectKernelsAgree(scene, "1,200 geometries", RenderCase{2, 16, 2, 0});
   std::filesystem::remove(path);
 }
@@ -385,13 +370,13 @@ TEST(Wavefront, SameImageAsScalarWhereMeshHitsArePrefetched) {
 // waves), and a sample range that does not start at 0: always the same film.
 TEST(Wavefront, SameImageForAnyThreadsTilesAndSampleRange) {
   const Scene scene = loadSmall(test::sourcePath("scenes/shapes.json"), 45, 30);
-  static_assert(40 * 30 > WavefrontIntegrator::kWaveSize);
+  static_assert(40 * 30 > WaveIntegrator::kWaveSize);
   const Film reference = renderWith(scene, Kernel::Scalar, RenderCase{1, 16, 5, 7});
   for (const RenderCase c : {RenderCase{1, 16, 5, 7}, RenderCase{2, 16, 5, 7}, RenderCase{2, 7, 5, 7},
                              RenderCase{2, 40, 5, 7}, RenderCase{1, 3, 5, 7}}) {
     const std::string what = "threads " + std::to_string(c.threads) + ", tile " + std::to_string(c.tileSize);
-    expectIdentical(reference, renderWith(scene, Kernel::Wavefront, c), what);
-    expectIdentical(reference, renderWith(scene, Kernel::Lanes, c), what + ", lanes");
+    expectIdentical(reference, renderWith(scene, Kernel::Wave, c), what);
+    expectIdentical(reference, renderWith(scene, Kernel::Wave, c), what + ", lanes");
   }
 }
 
@@ -400,15 +385,14 @@ TEST(Wavefront, CountsTheSameRaysAsScalar) {
   const Scene scene = loadSmall(test::sourcePath("scenes/cornell-area.json"), 24, 24);
   PathStats scalar, wave;
   renderWith(scene, Kernel::Scalar, {}, &scalar);
-  renderWith(scene, Kernel::Wavefront, {}, &wave);
+  renderWith(scene, Kernel::Wave, {}, &wave);
   EXPECT_EQ(scalar.rays, wave.rays);
   EXPECT_EQ(scalar.shadowRays, wave.shadowRays);
   EXPECT_EQ(scalar.vertices, wave.vertices);
   const Scene shapes = loadSmall(test::sourcePath("scenes/shapes.json"), 24, 24);
-  ASSERT_TRUE(LaneIntegrator::covers(shapes, Strategy::Mis));
   PathStats scalarShapes, lanes;
   renderWith(shapes, Kernel::Scalar, {}, &scalarShapes);
-  renderWith(shapes, Kernel::Lanes, {}, &lanes);
+  renderWith(shapes, Kernel::Wave, {}, &lanes);
   EXPECT_EQ(scalarShapes.rays, lanes.rays);
   EXPECT_EQ(scalarShapes.shadowRays, lanes.shadowRays);
   EXPECT_EQ(scalarShapes.vertices, lanes.vertices);
@@ -425,7 +409,7 @@ TEST(GeometryGroups, GroupsABatchByGeometryMissesFirst) {
     Rng rng(5, 9 + n);
     for (size_t i = 0; i < n; ++i)  // from in front of the open box: some rays leave the scene
       batch.push(Ray{Vec3(0.0f, 1.0f, 3.0f), sampleUniformSphere(Vec2(rng.uniform(), rng.uniform()))});
-    batch.trace(scene.accel(), BatchTraversal::Packets);
+    batch.trace(scene.accel());
     const auto key = [&](size_t a) { return uint32_t(batch.geometryOf(a) + 1u); };  // a miss (~0u) is 0
     std::vector<size_t> expected(n);
     for (size_t a = 0; a < n; ++a) expected[a] = a;
@@ -460,10 +444,11 @@ TEST(GeometryGroups, GroupsABatchByGeometryMissesFirst) {
 }
 
 TEST(Wavefront, KernelNames) {
-  EXPECT_EQ(parseKernel("wavefront"), Kernel::Wavefront);
-  EXPECT_EQ(parseKernel("stream"), Kernel::Stream);
+  EXPECT_EQ(parseKernel("wave"), Kernel::Wave);
+  EXPECT_EQ(parseKernel("wavefront"), Kernel::Wave);
+  EXPECT_EQ(parseKernel("lanes"), Kernel::Wave);
   EXPECT_EQ(parseKernel("scalar"), Kernel::Scalar);
-  EXPECT_EQ(parseKernel("lanes"), Kernel::Lanes);
+  EXPECT_FALSE(parseKernel("stream").has_value());  // retired with the copies it ran
   EXPECT_FALSE(parseKernel("packet").has_value());
 }
 

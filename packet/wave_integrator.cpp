@@ -1,13 +1,16 @@
-#include "packet/lane_integrator.h"
+#include "packet/wave_integrator.h"
 
 #include "core/sampling.h"
 #include "core/warp_lanes.h"
-#include "materials/lambertian.h"
-#include "materials/specular.h"
 #include "packet/arrival_lanes.h"
+#include "packet/bsdf_batch.h"
+#include "packet/caustic_wave.h"
 #include "packet/continuation_lanes.h"
+#include "packet/geometry_groups.h"
+#include "packet/hit_prefetch.h"
 #include "packet/next_event_lanes.h"
 #include "packet/packet_fields.h"
+#include "packet/ray_batch.h"
 #include "packet/thread_wave.h"
 #include "packet/timed_trace.h"
 #include "renderer/sampler_lanes.h"
@@ -29,7 +32,8 @@ namespace {
 // Three index spaces: camera samples (i, the wave's lanes), paths in flight (slot s, compacted
 // after every bounce) and the bounce's scattering vertices (v, in geometry order).
 struct LaneWave {
-  static constexpr size_t kSize = LaneIntegrator::kWaveSize;
+  static constexpr size_t kSize = WaveIntegrator::kWaveSize;
+  static_assert(kSize <= GeometryGroups::kMaxLanes);
   static_assert(kSize <= NextEventArrays::kCapacity);
   // Rows one cache line longer than the wave, for the reason NextEventArrays::kStride gives.
   template <class T>
@@ -46,15 +50,25 @@ struct LaneWave {
   // and throughputs beside their light samples, ContinuationArrays their BSDF samples and paths.
   NextEventArrays nee;
   ContinuationArrays cont;
-  // A Dirac vertex's material (mirror, glass: no light sample) and its full hit record, which the
-  // material's scalar sample() reads; null for a Lambertian vertex.
-  Row<const Material*> dirac;
-  Row<SurfaceHit> diracHit;
+  // A vertex the kernels do not evaluate inline (Material::lambertianAt is false there): its
+  // material, whose own methods evaluate and sample it, and its full hit record; null for a
+  // vertex in the kernels' Lambertian form.
+  Row<const Material*> general;
+  Row<SurfaceHit> hit;
   Row<const Light*> light;
   Row<Vec2> lightU;           // the light sample's numbers
   Row<uint16_t> lightVertex;  // the vertices that sample a light
-  // Light queries (q), sorted by light where that makes runs: samplerIndex << 16 | vertex.
-  Row<uint64_t> queryKey;
+  // Light queries (q), sorted by light where that makes runs: samplerIndex << 16 | vertex. Those of
+  // the kernels' Lambertian vertices fill the next-event rows; the general vertices' come back as
+  // LightSamples (Light::sampleLanes), for PathIntegrator::shadowFor.
+  Row<uint64_t> queryKey, generalKey;
+  Row<Vec3> generalRef;
+  Row<Vec2> generalU;
+  Row<LightSample> generalSample;
+  Row<bool> generalSampled;
+  // The general vertices' BSDF samples (Material::sampleLanes, one call per run of a material).
+  BsdfBatch bsdfs;
+  Row<uint16_t> generalVertex;
   // Sampler requests drawn together (renderer/sampler_lanes.h).
   Row<Sampler*> samplerOf;
   Row<float> drawn1D, roulette;
@@ -76,14 +90,6 @@ void store3(float (&rows)[3][NextEventArrays::kStride], size_t v, const Vec3& va
 }
 Vec3 load3(const float (&rows)[3][NextEventArrays::kStride], size_t v) {
   return {rows[0][v], rows[1][v], rows[2][v]};
-}
-
-// The constant reflectance of a shape whose hits the arrival kernel takes: a Lambertian material
-// without a texture. Null for any other (a Dirac material, a textured one, none).
-const Color* constantLambertian(const Scene::GeometryRecord& rec) {
-  if (rec.deltaLobes || !rec.material || !rec.shape) return nullptr;
-  const auto* lambertian = dynamic_cast<const Lambertian*>(rec.material);
-  return lambertian ? lambertian->constantReflectance() : nullptr;
 }
 
 // A row triple as the pointers ClosestHitBatch::assign takes.
@@ -213,38 +219,37 @@ void samplePointLight(const PointLight& light, const uint64_t* keys, size_t n, N
   }
 }
 
+// Samples the general vertices' lights (Light::sampleLanes, one call per run of a light) into
+// LightSamples, for PathIntegrator::shadowFor; sorted by light as sampleLights sorts.
+void sampleGeneralLights(LaneWave& wave, size_t queries, size_t lights) {
+  const auto keys = wave.generalKey.begin(), keysEnd = keys + ptrdiff_t(queries);
+  if (lights <= LaneWave::kSize / SolidAngleLanes::kMaxLanes && !std::is_sorted(keys, keysEnd))
+    std::sort(keys, keysEnd);
+  for (size_t q = 0; q < queries; ++q) {
+    const size_t v = wave.generalKey[q] & 0xffffu;
+    wave.generalRef[q] = wave.hit[v].p;
+    wave.generalU[q] = wave.lightU[v];
+  }
+  for (size_t first = 0; first < queries;) {
+    const Light* light = wave.light[wave.generalKey[first] & 0xffffu];
+    size_t end = first + 1;
+    while (end < queries && (wave.generalKey[end] >> 16) == (wave.generalKey[first] >> 16)) ++end;
+    light->sampleLanes(&wave.generalRef[first], &wave.generalU[first], end - first,
+                       &wave.generalSample[first], &wave.generalSampled[first]);
+    first = end;
+  }
+}
+
 }  // namespace
 
-std::string LaneIntegrator::uncovered(const Scene& scene, Strategy strategy) {
-  if (strategy != Strategy::Mis) return "strategy " + std::string(strategyName(strategy));
-  if (!scene.meshes.empty()) return "triangle meshes";
-  for (const Scene::ShapeEntry& entry : scene.shapes) {
-    const Material* m = entry.material;
-    if (m && !dynamic_cast<const Lambertian*>(m) && !dynamic_cast<const Mirror*>(m) &&
-        !dynamic_cast<const Refraction*>(m) && !dynamic_cast<const Dielectric*>(m))
-      return "a " + std::string(m->typeName()) + " material";
-  }
-  return "";
+void WaveIntegrator::traceCaustics(const Scene& scene, uint64_t seed, SamplerType sampler,
+                                   uint64_t firstIndex, int count, CausticSplats& splats,
+                                   PathStats& stats) const {
+  traceCausticsInWaves(scene, maxDepth(), rrDepth(), seed, sampler, firstIndex, count, splats, stats);
 }
 
-bool LaneIntegrator::coversOnce(const Scene& scene) const {
-  const uint64_t last = lastCovered_.load(std::memory_order_relaxed);
-  if (last >> 1 == scene.buildSerial()) return last & 1u;
-  const bool answer = covers(scene, path_.strategy());
-  lastCovered_.store(scene.buildSerial() << 1 | uint64_t(answer), std::memory_order_relaxed);
-  return answer;
-}
-
-void LaneIntegrator::renderTile(const Scene& scene, const TileWork& work, Film& film,
+void WaveIntegrator::renderTile(const Scene& scene, const TileWork& work, Film& film,
                                 PathStats& stats) const {
-  if (coversOnce(scene))
-    renderLanes(scene, work, film, stats);
-  else
-    wavefront_.renderTile(scene, work, film, stats);
-}
-
-void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film& film,
-                                 PathStats& stats) const {
   LaneWave& wave = threadWave<LaneWave>();
   NextEventArrays& nee = wave.nee;
   wave.closest.setWidth(scene.accel().packetWidth());
@@ -255,7 +260,6 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
   const LightSampler& lights = scene.lightSampler();
   const RequestUse lightUse{lights.size() > 1, lights.deltaLightCount() < lights.size()};
   const int maxDepth = path_.maxDepth(), rrDepth = path_.rrDepth();
-  const bool tracesCaustics = path_.tracesCaustics();
 
   // Camera sample k of the tile is pixel k % pixels (row by row) of sample k / pixels; the wave
   // steps through them in that order, counting instead of dividing.
@@ -310,168 +314,117 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
     phases.mark(PathPhase::Camera);
     while (active > 0) {
       stats.rays += active;
-      traceTimed(wave.closest, scene.accel(), BatchTraversal::Packets, stats);
+      traceTimed(wave.closest, scene.accel(), stats);
       phases.mark(PathPhase::TraceClosest);
 
-      // PathIntegrator::arrive for every path: its emission, or the environment's where it left
-      // the scene, and the vertices that scatter. At unbounded depth (where every path goes on
-      // from a Lambertian vertex) a run of hits on a shape with a constant Lambertian reflectance
-      // arrives in the vector kernel (packet/arrival_lanes.h), every other hit one at a time.
+      // PathIntegrator::arrive for every path, and onMiss for those that left the scene: the
+      // reference's own steps, on the path's state gathered from its slot. A run of hits on an
+      // analytic shape with a uniform Lambertian reflectance and no emission, at unbounded depth
+      // (where every such path scatters), arrives in the vector kernel instead
+      // (packet/arrival_lanes.h).
       wave.groups.group(wave.closest, active, scene.geometryCount());
       size_t vertices = 0, lightDraws = 0;
-      // PathIntegrator::arrive's emission at vertex point p, normal ng, for the path in slot s; a
-      // caustic path's is the light tracer's.
-      const auto addEmission = [&](const Scene::GeometryRecord& rec, size_t s, const Vec3& p, const Vec3& ng,
-                                   const Vec3& wo, const Color& throughput) {
-        const bool previousDelta = paths.previousDelta[s] != 0;
-        const bool caustic = tracesCaustics && previousDelta && paths.firstBounceNonDelta[s] != 0 &&
-                             rec.light && rec.light->causticTraced;
-        if (isBlack(rec.emission) || !(rec.twoSidedEmission || glm::dot(wo, ng) > 0.0f) || caustic) return;
-        float weight = 1.0f;
-        if (!previousDelta) {
-          const float lightPdf =
-              rec.light ? lights.pmf(rec.light) * rec.light->pdf(load3(paths.previousPoint, s), p, ng) : 0.0f;
-          weight = powerHeuristic(paths.previousPdf[s], lightPdf);
-        }
-        wave.radiance[size_t(paths.owner[s])] += throughput * rec.emission * weight;
+      const auto gather = [&](size_t s) {
+        PathState path;
+        path.ray = Ray{load3(paths.origin, s), load3(paths.dir, s)};
+        path.radiance = wave.radiance[size_t(paths.owner[s])];
+        path.throughput = load3(paths.throughput, s);
+        path.etaProduct = paths.etaProduct[s];
+        path.previousDelta = paths.previousDelta[s] != 0;
+        path.previousPdf = paths.previousPdf[s];
+        path.previousPoint = load3(paths.previousPoint, s);
+        path.rayMask = paths.mask[s];
+        path.depth = paths.depth[s];
+        path.firstBounceNonDelta = paths.firstBounceNonDelta[s] != 0;
+        return path;
       };
-      const auto arriveOne = [&](size_t s) {
-        const Vec3 dir = load3(paths.dir, s);
-        Color throughput = load3(paths.throughput, s);
+      const bool prefetch = scene.prefetchesMeshHits();
+      const auto arriveOne = [&](size_t o) {
+        if (prefetch) prefetchGroupedHits(scene, wave.closest, wave.groups, o, active);
+        const size_t s = wave.groups.order()[o];
         const int32_t owner = paths.owner[s];
-        const bool previousDelta = paths.previousDelta[s] != 0;
+        PathState path = gather(s);
         RawHit raw;
         if (!wave.closest.hit(s, raw)) {
-          // PathIntegrator::onMiss: the environment the ray sees, if any; the path ends.
-          if (const EnvironmentLight* env = scene.environment()) {
-            float weight = 1.0f;
-            if (!previousDelta)
-              weight = powerHeuristic(paths.previousPdf[s], lights.pmf(env) * env->pdfDirection(dir));
-            wave.radiance[owner] += throughput * env->radiance(dir) * weight;
-          }
+          path_.onMiss(scene, path);
+          wave.radiance[size_t(owner)] = path.radiance;
           return;
         }
-        ++stats.vertices;
-        const Scene::GeometryRecord& rec = scene.record(raw.geomID);
-        const Material* material = rec.material;
-        const bool isDirac = rec.deltaLobes;
-        const Vec3 origin = load3(paths.origin, s);
-        const Vec3 wo = -dir;
-        Vec3 p;
-        float pError;
-        SurfaceHit* hit = nullptr;
-        if (isDirac) {
-          // The whole record, for the material's sample(); and the medium the ray crossed.
-          hit = &wave.diracHit[vertices];
-          scene.surfaceHit(Ray{origin, dir}, raw, *hit);
-          p = hit->p;
-          pError = hit->pError;
-          if (glm::dot(dir, raw.ng) > 0.0f) {
-            throughput *= material->interiorTransmittance(raw.t);
-            if (isBlack(throughput)) return;
-          }
-        } else {
-          // Scene::surfaceHit for an analytic shape, without the parts a Lambertian vertex never
-          // reads (the shading normal equals ng; texture coordinates only for the reflectance).
-          // A Lambertian surface has no interior to attenuate.
-          const Vec3 p0 = origin + raw.t * dir;
-          const float magnitude = maxAbsComponent(p0);
-          p = p0;
-          if (raw.t > magnitude) {
-            const SurfacePoint onSurface = rec.shape->projectToSurface(p0, LocalHit{raw.t, raw.ng, raw.uv});
-            p = onSurface.p;
-            pError = onSurface.error;
-          } else {
-            pError = roundingErrorBound(magnitude + raw.t);
-          }
-        }
-        addEmission(rec, s, p, raw.ng, wo, throughput);
-        if ((maxDepth >= 0 && paths.depth[s] >= maxDepth) || !material) return;
-        const size_t v = vertices;
-        if (isDirac) {
-          if (material->absorbsAt(*hit)) return;
-          wave.dirac[v] = material;
-        } else {
-          const auto* lambertian = static_cast<const Lambertian*>(material);
-          const Color* constant = lambertian->constantReflectance();
-          const Color albedo =
-              constant ? *constant
-                       : lambertian->reflectanceAt(rec.shape->surfaceUv(LocalHit{raw.t, raw.ng, raw.uv}));
-          if (isBlack(albedo)) return;  // Material::absorbsAt: black only where the texture may be
-          store3(nee.albedo, v, albedo);
-          wave.dirac[v] = nullptr;
-          if (!lights.empty()) wave.lightVertex[lightDraws++] = uint16_t(v);
-        }
-        wave.bsdfUse[v] = RequestUse{material->usesDirectionSample(), material->usesLobeSample()};
-        ++vertices;
-        store3(nee.p, v, p);
-        store3(nee.ng, v, raw.ng);
-        nee.pError[v] = pError;
-        store3(nee.wo, v, wo);
-        store3(nee.throughput, v, throughput);
+        SurfaceHit& hit = wave.hit[vertices];
+        scene.surfaceHit(path.ray, raw, hit);
+        const bool scatters = path_.arrive(scene, path, hit, stats);
+        wave.radiance[size_t(owner)] = path.radiance;
+        if (!scatters) return;
+        const size_t v = vertices++;
+        Color reflectance;
+        const bool inline_ = hit.material->lambertianAt(hit, reflectance);
+        wave.general[v] = inline_ ? nullptr : hit.material;
+        if (inline_) store3(nee.albedo, v, reflectance);
+        cont.dirac[v] = inline_ ? 0 : -1;
+        wave.bsdfUse[v] = RequestUse{hit.material->usesDirectionSample(), hit.material->usesLobeSample()};
+        if (path_.samplesLights(scene, hit)) wave.lightVertex[lightDraws++] = uint16_t(v);
+        store3(nee.p, v, hit.p);
+        store3(nee.ng, v, hit.ng);
+        nee.pError[v] = hit.pError;
+        store3(nee.wo, v, -path.ray.dir);
+        store3(nee.throughput, v, path.throughput);
         nee.lightPdf[v] = -1.0f;
         nee.pointLight[v] = 0;
         nee.infinite[v] = 0;
-        cont.dirac[v] = isDirac ? -1 : 0;
         cont.sampledDelta[v] = 0;
-        cont.etaProduct[v] = paths.etaProduct[s];
+        cont.etaProduct[v] = path.etaProduct;
         cont.owner[v] = owner;
-        cont.depth[v] = paths.depth[s];
-        cont.firstBounceNonDelta[v] = paths.firstBounceNonDelta[s];
-        cont.maskFront[v] = rec.maskFront;
-        cont.maskBack[v] = rec.maskBack;
+        cont.depth[v] = path.depth;
+        cont.firstBounceNonDelta[v] = path.firstBounceNonDelta ? -1 : 0;
+        cont.maskFront[v] = hit.maskFront;
+        cont.maskBack[v] = hit.maskBack;
       };
+      const bool runsSampleLights = path_.strategy() != Strategy::Bsdf && !lights.empty();
       const HitFields hitFields = wave.closest.hitFields();
       for (size_t r = 0; r < wave.groups.runCount(); ++r) {
         const GeometryGroups::Run run = wave.groups.runs()[r];
         const uint16_t* slots = wave.groups.order() + run.begin;
         const size_t count = size_t(run.end - run.begin);
-        const Color* albedo = run.geometry == RTC_INVALID_GEOMETRY_ID
-                                  ? nullptr
-                                  : constantLambertian(scene.record(run.geometry));
+        const Scene::GeometryRecord* rec =
+            run.geometry == RTC_INVALID_GEOMETRY_ID ? nullptr : &scene.record(run.geometry);
+        const Color* albedo = rec && rec->shape && rec->material && isBlack(rec->emission)
+                                  ? rec->material->uniformLambertian()
+                                  : nullptr;
         if (maxDepth >= 0 || !albedo || isBlack(*albedo)) {
-          for (size_t j = 0; j < count; ++j) arriveOne(slots[j]);
+          for (size_t o = run.begin; o < run.end; ++o) arriveOne(o);
           continue;
         }
-        // Every path of the run scatters at its vertex: the depth is unbounded and the
-        // reflectance not black.
-        const Scene::GeometryRecord& rec = scene.record(run.geometry);
+        // Every path of the run scatters at its vertex: the depth is unbounded, the reflectance
+        // not black, and the surface emits nothing.
         const size_t first = vertices;
         const size_t far = arriveLambertianLanes(
-            hitFields, paths, LambertianRun{slots, count, first, *albedo, rec.maskFront, rec.maskBack}, nee,
+            hitFields, paths, LambertianRun{slots, count, first, *albedo, rec->maskFront, rec->maskBack}, nee,
             cont, wave.project.data());
-        for (size_t j = 0; j < far; ++j) {  // the scalar arrival's projection branch
+        for (size_t j = 0; j < far; ++j) {  // Scene::surfaceHit's projection branch
           const size_t v = size_t(wave.project[j]);
           RawHit raw;
           wave.closest.hit(slots[v - first], raw);
           const SurfacePoint onSurface =
-              rec.shape->projectToSurface(load3(nee.p, v), LocalHit{raw.t, raw.ng, raw.uv});
+              rec->shape->projectToSurface(load3(nee.p, v), LocalHit{raw.t, raw.ng, raw.uv});
           store3(nee.p, v, onSurface.p);
           nee.pError[v] = onSurface.error;
         }
-        if (!isBlack(rec.emission))
-          for (size_t j = 0; j < count; ++j) {
-            const size_t v = first + j;
-            addEmission(rec, slots[j], load3(nee.p, v), load3(nee.ng, v), load3(nee.wo, v),
-                        load3(nee.throughput, v));
-          }
-        std::fill_n(&wave.dirac[first], count, nullptr);
+        std::fill_n(&wave.general[first], count, nullptr);
         std::fill_n(&wave.bsdfUse[first], count,
-                    RequestUse{rec.material->usesDirectionSample(), rec.material->usesLobeSample()});
-        if (!lights.empty())
+                    RequestUse{rec->material->usesDirectionSample(), rec->material->usesLobeSample()});
+        if (runsSampleLights)
           for (size_t j = 0; j < count; ++j) wave.lightVertex[lightDraws++] = uint16_t(first + j);
         vertices += count;
         stats.vertices += count;
       }
       phases.mark(PathPhase::Arrival);
 
-      // The light choice at the Lambertian vertices (pickLight: its 1D, then its 2D request) and
-      // the lights' samples.
+      // The light choice (pickLight: its 1D, then its 2D request) and the lights' samples.
       for (size_t j = 0; j < lightDraws; ++j)
         wave.samplerOf[j] = &wave.samplers[size_t(cont.owner[wave.lightVertex[j]])];
       draw1DThen2DLanes(wave.samplerOf.data(), lightDraws, wave.drawn1D.data(), wave.drawn2D.data(),
                         lightUse);
-      size_t queries = 0;
+      size_t queries = 0, generalQueries = 0;
       for (size_t j = 0; j < lightDraws; ++j) {
         LightPick pick;
         if (!PathIntegrator::pickLightWith(scene, wave.drawn1D[j], wave.drawn2D[j], pick)) continue;
@@ -480,16 +433,41 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
         nee.lightMask[v] = pick.light->shadowMask;
         wave.lightU[v] = pick.u;
         nee.pmf[v] = pick.pmf;
-        wave.queryKey[queries++] = uint64_t(pick.light->samplerIndex) << 16 | v;
+        const uint64_t key = uint64_t(pick.light->samplerIndex) << 16 | v;
+        if (wave.general[v])
+          wave.generalKey[generalQueries++] = key;
+        else
+          wave.queryKey[queries++] = key;
       }
       phases.mark(PathPhase::LightChoice);
       sampleLights(wave, queries, lights.size());
+      sampleGeneralLights(wave, generalQueries, lights.size());
       phases.mark(PathPhase::LightSamples);
 
-      const size_t shadowRays = nextEventLanes(nee, cont.maskFront, cont.maskBack, vertices);
+      // PathIntegrator::shadowFor: the kernel's Lambertian vertices together, then the general
+      // vertices' own, appended to the compacted shadow rows.
+      size_t shadowRays =
+          nextEventLanes(nee, cont.maskFront, cont.maskBack, vertices, path_.strategy() == Strategy::Mis);
+      stats.shadowRays += shadowRays;
+      for (size_t q = 0; q < generalQueries; ++q) {
+        const size_t v = wave.generalKey[q] & 0xffffu;
+        PathState path;
+        path.ray.dir = -load3(nee.wo, v);
+        path.throughput = load3(nee.throughput, v);
+        const LightPick pick{wave.light[v], nee.pmf[v], wave.lightU[v]};
+        ShadowRequest shadow;
+        if (!path_.shadowFor(wave.hit[v], path, pick, wave.generalSample[q], wave.generalSampled[q], stats,
+                             shadow))
+          continue;
+        store3(nee.contribution, v, shadow.contribution);
+        store3(nee.shadowOrigin, shadowRays, shadow.ray.origin);
+        store3(nee.shadowDir, shadowRays, shadow.ray.dir);
+        nee.shadowTMax[shadowRays] = shadow.ray.tMax;
+        nee.shadowMask[shadowRays] = shadow.mask;
+        nee.shadowVertex[shadowRays++] = int32_t(v);
+      }
       wave.shadows.assign(rowsOf(nee.shadowOrigin), rowsOf(nee.shadowDir), nee.shadowTMax, nee.shadowMask,
                           shadowRays);
-      stats.shadowRays += shadowRays;
       phases.mark(PathPhase::NextEvent);
 
       // PathIntegrator::drawBsdfSample: its 2D, then its 1D request; then Russian roulette's
@@ -508,41 +486,48 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
       for (size_t j = 0; j < plays; ++j) cont.roulette[wave.rouletteVertex[j]] = wave.roulette[j];
       phases.mark(PathPhase::BsdfSamples);
 
-      // The BSDF samples (Lambertian::sample in blocks of the cosine kernel, a Dirac material's
-      // own sample()) into the continuation's rows, then followBsdfSample for all vertices in one
-      // kernel, which writes the paths that go on into the slots, and their rays as the next batch.
+      // The BSDF samples: the Lambertian vertices' in blocks of the cosine kernel
+      // (Lambertian::sample's), the general vertices' from their materials (Material::sampleLanes,
+      // one call per run of a material), into the continuation's rows; then followBsdfSample for
+      // all vertices in one kernel, which writes the paths that go on into the slots, and their
+      // rays as the next batch.
+      size_t generals = 0;
       for (size_t block = 0; block < vertices; block += CosineLanes::kMaxLanes) {
         const unsigned n = unsigned(std::min<size_t>(CosineLanes::kMaxLanes, vertices - block));
         for (unsigned i = 0; i < n; ++i) {
           const size_t v = block + i;
           const Vec3 ng = load3(nee.ng, v), wo = load3(nee.wo, v);
           wave.cosine.set(i, glm::dot(wo, ng) >= 0.0f ? ng : -ng, wave.drawn2D[v]);
+          if (!wave.general[v]) continue;
+          wave.bsdfs.hit[generals] = &wave.hit[v];
+          wave.bsdfs.wo[generals] = wo;
+          wave.bsdfs.u[generals] = wave.drawn2D[v];
+          wave.bsdfs.uLobe[generals] = wave.drawn1D[v];
+          wave.generalVertex[generals++] = uint16_t(v);
         }
         sampleCosineLanes(wave.cosine, wave.cosine.padFrom(n));
         // Whole blocks, so that the continuation kernel's vector loads find whole stores.
         for (int c = 0; c < 3; ++c) std::copy_n(wave.cosine.wi[c], n, &cont.wi[c][block]);
         std::copy_n(wave.cosine.pdf, n, &cont.pdf[block]);
-        for (unsigned i = 0; i < n; ++i) {
-          const size_t v = block + i;
-          const Material* material = wave.dirac[v];
-          if (!material) continue;
-          BsdfSample bs;
-          const bool sampled =
-              material->sample(wave.diracHit[v], load3(nee.wo, v), wave.drawn2D[v], wave.drawn1D[v], bs);
-          cont.diracSampled[v] = sampled ? -1 : 0;
-          if (!sampled) continue;
-          store3(cont.wi, v, bs.wi);
-          store3(cont.weight, v, bs.weight);
-          cont.pdf[v] = bs.pdf;
-          cont.eta[v] = bs.eta;
-          cont.sampledDelta[v] = bs.delta ? -1 : 0;
-        }
+      }
+      wave.bsdfs.sampleAll(generals);
+      for (size_t g = 0; g < generals; ++g) {
+        const size_t v = wave.generalVertex[g];
+        const bool sampled = wave.bsdfs.sampled[g];
+        cont.diracSampled[v] = sampled ? -1 : 0;
+        if (!sampled) continue;
+        const BsdfSample& bs = wave.bsdfs.sample[g];
+        store3(cont.wi, v, bs.wi);
+        store3(cont.weight, v, bs.weight);
+        cont.pdf[v] = bs.pdf;
+        cont.eta[v] = bs.eta;
+        cont.sampledDelta[v] = bs.delta ? -1 : 0;
       }
       const size_t next = continuationLanes(nee, cont, vertices, rrDepth, paths);
       wave.closest.assign(rowsOf(paths.origin), rowsOf(paths.dir), paths.mask, next);
       phases.mark(PathPhase::Continuation);
 
-      traceTimed(wave.shadows, scene.accel(), BatchTraversal::Packets, stats);
+      traceTimed(wave.shadows, scene.accel(), stats);
       for (size_t j = 0; j < wave.shadows.size(); ++j) {
         if (wave.shadows.occluded(j)) continue;
         const size_t v = size_t(nee.shadowVertex[j]);
@@ -556,6 +541,21 @@ void LaneIntegrator::renderLanes(const Scene& scene, const TileWork& work, Film&
       addToFilm(film, work, wave.x[i], wave.y[i], wave.sample[i], wave.radiance[i], stats);
     phases.mark(PathPhase::Camera);
   }
+}
+
+}  // namespace ember
+
+namespace ember {
+
+std::optional<Kernel> parseKernel(std::string_view name) {
+  if (name == "wave" || name == "lanes" || name == "wavefront") return Kernel::Wave;
+  if (name == "scalar") return Kernel::Scalar;
+  return std::nullopt;
+}
+
+std::unique_ptr<Integrator> makeIntegrator(const RenderSettings& settings, Kernel kernel) {
+  if (kernel == Kernel::Scalar) return std::make_unique<PathIntegrator>(settings);
+  return std::make_unique<WaveIntegrator>(settings);
 }
 
 }  // namespace ember
