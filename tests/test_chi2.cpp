@@ -826,8 +826,9 @@ const std::vector<Chi2Case>& allCases() {
         woBelow(-0.3f, 0.5f, -0.8f);
 
     // Lambertian.
-    for (const auto& [name, wo] :
+    for (const auto& [name, woBinding] :
          {std::pair{"Normal", woNormal}, std::pair{"Oblique", woOblique}, std::pair{"Below", woBelow}}) {
+      const Vec3 wo = woBinding;  // clang 14 cannot capture structured bindings
       add(std::string("Lambertian_wo") + name, [wo](uint64_t s) {
         runMaterial(std::make_shared<Lambertian>(constant(Color(0.7f, 0.5f, 0.3f))), wo, s);
       });
@@ -843,7 +844,9 @@ const std::vector<Chi2Case>& allCases() {
                          {"ks90", Color(0.0f), Color(0.9f)}};
     for (float exponent : {1.0f, 10.0f, 100.0f}) {
       for (const Mix& mix : mixes) {
-        for (const auto& [woName, wo] : {std::pair{"Oblique", woOblique}, std::pair{"Grazing", woGrazing}}) {
+        for (const auto& [woName, woBinding] :
+             {std::pair{"Oblique", woOblique}, std::pair{"Grazing", woGrazing}}) {
+          const Vec3 wo = woBinding;  // clang 14 cannot capture structured bindings
           add("Phong_n" + std::to_string(int(exponent)) + "_" + mix.name + "_wo" + woName,
               [mix, exponent, wo](uint64_t s) {
                 runMaterial(std::make_shared<Phong>(constant(mix.kd), mix.ks, exponent), wo, s);

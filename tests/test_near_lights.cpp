@@ -268,8 +268,10 @@ TEST(NearLights, PolygonsMatchLambertsContourIntegral) {
   const auto uv4 = std::array<Vec2, 4>{Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)};
   const auto uv3 = std::array<Vec2, 3>{Vec2(0, 0), Vec2(1, 0), Vec2(0, 1)};
 
-  for (const auto& [label, quad] :
-       {std::pair{"grazing quad", grazing}, std::pair{"piercing quad", piercing}}) {
+  for (const auto& labelled : {std::pair{"grazing quad", grazing}, std::pair{"piercing quad", piercing}}) {
+    // Named copies, not structured bindings: C++20 lets a lambda capture those, clang 14 does not.
+    const char* const label = labelled.first;
+    const auto& quad = labelled.second;
     // Emitting towards the origin: the normal cross(v1 - v0, v2 - v0) must face it.
     const Vec3 n = glm::cross(quad[1] - quad[0], quad[2] - quad[0]);
     ASSERT_LT(glm::dot(n, quad[0]), 0.0f) << label;

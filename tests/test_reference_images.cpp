@@ -97,7 +97,8 @@ void PrintTo(const StrategyCase& c, std::ostream* os) {
 class StrategyReference : public ::testing::TestWithParam<StrategyCase> {};
 
 TEST_P(StrategyReference, MatchesMitsubaWithinNoise) {
-  const auto& [name, strategy] = GetParam();
+  const auto& [name, strategyBinding] = GetParam();
+  const Strategy strategy = strategyBinding;  // clang 14 cannot capture structured bindings
   const auto set = [strategy](Scene& s) { s.settings.strategy = strategy; };
   const Rendered both = average(renderScene(name, 1, kSpp, set), renderScene(name, 2, kSpp, set));
   const Reference ref = loadReference(name);

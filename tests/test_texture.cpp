@@ -198,8 +198,10 @@ TEST(ImageTexture, WrappedLookupsEqualTheReferenceFormula) {
         for (Color& t : texels) t = Color(rng.uniform(), rng.uniform() * 4.0f, 1000.0f * rng.uniform());
         const ImageTexture bilinear(w, h, texels, TextureFilter::Bilinear, ws, wt, Color(1.0f));
         const ImageTexture nearest(w, h, texels, TextureFilter::Nearest, ws, wt, Color(1.0f));
+        const int width = w, height = h;  // clang 14 cannot capture structured bindings
         const auto at = [&](int x, int y) {
-          return texels[size_t(referenceWrap(y, h, wt)) * size_t(w) + size_t(referenceWrap(x, w, ws))];
+          return texels[size_t(referenceWrap(y, height, wt)) * size_t(width) +
+                        size_t(referenceWrap(x, width, ws))];
         };
         for (int i = 0; i < 400; ++i) {
           const float range = i % 4 == 0 ? 1e6f : i % 4 == 1 ? 3.0f : 1.0f;
