@@ -30,6 +30,7 @@ EmbreeAccel::EmbreeAccel() {
 
 EmbreeAccel::~EmbreeAccel() {
   if (scene_) rtcReleaseScene(scene_);
+  for (RTCScene prototype : prototypes_) rtcReleaseScene(prototype);
   if (device_) rtcReleaseDevice(device_);
 }
 
@@ -71,8 +72,8 @@ static void meshOpacityFilter(const RTCFilterFunctionNArguments* args) {
   }
 }
 
-uint32_t EmbreeAccel::addMesh(const TriangleMesh* mesh) {
-  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+static uint32_t attachMesh(RTCDevice device, RTCScene scene, const TriangleMesh* mesh) {
+  RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
   rtcSetGeometryMask(geom, kAllRayMask);  // every ray tests meshes (Embree 3's default, stated)
   // Embree-owned buffers: Embree pads them as its SIMD loads need (16 bytes past the end).
   auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
@@ -87,8 +88,34 @@ uint32_t EmbreeAccel::addMesh(const TriangleMesh* mesh) {
     rtcSetGeometryOccludedFilterFunction(geom, meshOpacityFilter);
   }
   rtcCommitGeometry(geom);
+  const uint32_t id = rtcAttachGeometry(scene, geom);
+  rtcReleaseGeometry(geom);
+  return id;
+}
+
+uint32_t EmbreeAccel::addMesh(const TriangleMesh* mesh) {
+  return attachMesh(device_, scene_, mesh);
+}
+
+uint32_t EmbreeAccel::addPrototype(const TriangleMesh* mesh) {
+  RTCScene prototype = rtcNewScene(device_);
+  rtcSetSceneBuildQuality(prototype, RTC_BUILD_QUALITY_MEDIUM);
+  attachMesh(device_, prototype, mesh);
+  rtcCommitScene(prototype);
+  prototypes_.push_back(prototype);
+  return uint32_t(prototypes_.size() - 1);
+}
+
+uint32_t EmbreeAccel::addInstance(uint32_t prototype, const Mat4& toWorld) {
+  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
+  rtcSetGeometryInstancedScene(geom, prototypes_.at(prototype));
+  rtcSetGeometryTimeStepCount(geom, 1);
+  rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, &toWorld[0][0]);
+  rtcSetGeometryMask(geom, kAllRayMask);
+  rtcCommitGeometry(geom);
   const uint32_t id = rtcAttachGeometry(scene_, geom);
   rtcReleaseGeometry(geom);
+  ++instances_;
   return id;
 }
 
@@ -128,7 +155,7 @@ bool EmbreeAccel::intersect(const Ray& ray, RawHit& hit, uint32_t mask) const {
   rtcIntersect1(scene_, &context, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
   hit.t = rh.ray.tfar;
-  hit.geomID = rh.hit.geomID;
+  hit.geomID = hitGeometry(rh.hit.geomID, rh.hit.instID[0]);
   hit.primID = rh.hit.primID;
   hit.ng = Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
   hit.uv = Vec2(rh.hit.u, rh.hit.v);

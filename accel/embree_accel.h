@@ -58,6 +58,13 @@ class EmbreeAccel {
   // coordinates (accel/shape_lanes.h, RayLanes::needsUv).
   uint32_t addShape(const Shape* shape, bool needsUv = true, uint32_t mask = kAllRayMask);
   uint32_t addMesh(const TriangleMesh* mesh);
+  // Instancing: a mesh built once into a BVH of its own (a prototype; the returned index names it),
+  // placed any number of times by addInstance, which returns the instance's geomID. Hits on an
+  // instance report that geomID (never the mesh's inside its prototype), so callers index their
+  // tables the same way for instances and plain geometries.
+  uint32_t addPrototype(const TriangleMesh* mesh);
+  uint32_t addInstance(uint32_t prototype, const Mat4& toWorld);
+  bool hasInstances() const { return instances_ > 0; }
   void commit();
 
   bool intersect(const Ray& ray, RawHit& hit, uint32_t mask = kAllRayMask) const;
@@ -81,6 +88,14 @@ class EmbreeAccel {
   RTCScene scene_ = nullptr;
   unsigned packetWidth_ = 16;
   std::vector<std::unique_ptr<ShapeGeometry>> shapes_;  // the user geometries' data
+  std::vector<RTCScene> prototypes_;
+  size_t instances_ = 0;
 };
+
+// A hit on an instance names the instance's geomID: Embree reports the mesh's geomID inside its
+// prototype and the instance's in instID[0].
+inline uint32_t hitGeometry(uint32_t geomID, uint32_t instID) {
+  return instID != RTC_INVALID_GEOMETRY_ID ? instID : geomID;
+}
 
 }  // namespace ember

@@ -48,7 +48,10 @@ Runner addInfoCommand(CLI::App& app) {
       std::printf("fov_y %g deg\n", c.fovYDeg);
     std::printf("shapes:     %zu", scene.shapes.size());
     for (const auto& [type, n] : byType) std::printf("  %s %d", type.c_str(), n);
-    std::printf("\nmeshes:     %zu (%zu triangles)\n", scene.meshes.size(), scene.triangleCount());
+    std::printf("\nmeshes:     %zu (%zu triangles", scene.meshes.size(), scene.triangleCount());
+    if (scene.uniqueTriangleCount() != scene.triangleCount())
+      std::printf("; %zu unique, the rest instances of them", scene.uniqueTriangleCount());
+    std::printf(")\n");
     std::printf(
         "lights:     %zu punctual, %d area (%d two-sided), %zu emissive triangles (%zu two-sided), %s "
         "environment\n",

@@ -26,8 +26,12 @@ void SampleCosineLanes(CosineLanes& lanes, unsigned count) {
     const M centre = hn::And(hn::Eq(ox, zero), hn::Eq(oy, zero));
     const M wide = hn::Gt(hn::Abs(ox), hn::Abs(oy));
     const V r = hn::IfThenElse(wide, ox, oy);
-    const V theta = hn::IfThenElse(wide, hn::Mul(quarterPi, hn::Div(oy, ox)),
-                                   hn::Sub(hn::Set(d, 0.5f * kPi), hn::Mul(quarterPi, hn::Div(ox, oy))));
+    // At the centre 0/0 is NaN, which Highway's Cos and Sin convert to an integer in their range
+    // reduction (undefined behaviour in its scalar target): the angle is zeroed there, and the
+    // centre's direction does not read it.
+    const V theta = hn::IfThenZeroElse(
+        centre, hn::IfThenElse(wide, hn::Mul(quarterPi, hn::Div(oy, ox)),
+                               hn::Sub(hn::Set(d, 0.5f * kPi), hn::Mul(quarterPi, hn::Div(ox, oy)))));
     const V dx = hn::IfThenZeroElse(centre, hn::Mul(r, hn::Cos(d, theta)));
     const V dy = hn::IfThenZeroElse(centre, hn::Mul(r, hn::Sin(d, theta)));
     const V z = hn::Sqrt(hn::Max(zero, hn::Sub(hn::Sub(one, hn::Mul(dx, dx)), hn::Mul(dy, dy))));

@@ -1,6 +1,7 @@
 #include "io/gltf_loader.h"
 
 #include "accel/cylinder.h"
+#include "accel/mesh_instance.h"
 #include "accel/sphere.h"
 #include "io/gltf_compression.h"
 #include "io/gltf_materials.h"
@@ -69,6 +70,7 @@ class GltfImporter {
       for (int i = 0; i < int(model_.nodes.size()); ++i)
         if (!children.count(i)) roots.push_back(i);
     }
+    countPlacements();
     std::vector<int> stack;
     const size_t firstMesh = scene_.meshes.size();
     for (int root : roots) visit(root, options_.transform, stack);
@@ -644,7 +646,7 @@ class GltfImporter {
   void makePointsAndLines(size_t firstMesh) {
     if (pointsAndLines_.empty()) return;
     Bounds bounds;
-    for (size_t i = firstMesh; i < scene_.meshes.size(); ++i) bounds.extend(scene_.meshes[i].mesh->bounds());
+    for (size_t i = firstMesh; i < scene_.meshes.size(); ++i) bounds.extend(scene_.meshes[i].worldBounds());
     for (const PointsOrLines& item : pointsAndLines_)
       for (const Vec3& p : item.points) bounds.extend(p);
     const float radius = std::max(kCurveRadius * glm::length(bounds.upper - bounds.lower), 1e-6f);
@@ -667,21 +669,89 @@ class GltfImporter {
     }
   }
 
+  // What makes two primitives the same triangles: their mode and the accessors of their indices
+  // and vertex attributes (not their material). Nodes that place the same triangles share one mesh
+  // (Scene::MeshEntry::toWorld): files reuse an accessor under several meshes of different
+  // materials, as MetalRoughSpheresNoTextures does for its 98 spheres.
+  static std::string geometryKey(const tinygltf::Primitive& prim) {
+    std::string key = std::to_string(prim.mode) + "/" + std::to_string(prim.indices);
+    for (const auto& [name, accessor] : prim.attributes)  // a std::map: in name order
+      key += "/" + name + "=" + std::to_string(accessor);
+    return key;
+  }
+
+  // How many times the file places each primitive's triangles (every node's mesh, reachable or not).
+  void countPlacements() {
+    for (const tinygltf::Node& node : model_.nodes)
+      if (node.mesh >= 0 && size_t(node.mesh) < model_.meshes.size())
+        for (const tinygltf::Primitive& prim : model_.meshes[size_t(node.mesh)].primitives)
+          ++placements_[geometryKey(prim)];
+  }
+
   void readPrimitive(const tinygltf::Primitive& prim, const Mat4& world, const std::string& where) {
     const int mode = prim.mode < 0 ? kModeTriangles : prim.mode;
     if (mode < kModePoints || mode > kModeFan)
       fail(where + ".mode", "unknown primitive mode " + std::to_string(mode));
+    if (mode != kModeTriangles && mode != kModeStrip && mode != kModeFan) {
+      const auto pos = prim.attributes.find("POSITION");
+      if (pos == prim.attributes.end()) fail(where, "primitive has no POSITION attribute");
+      size_t vertexCount = 0;
+      const std::vector<float> positions =
+          readFloats(pos->second, TINYGLTF_TYPE_VEC3, where + ".attributes.POSITION", vertexCount);
+      readPointsOrLines(prim, mode, world, positions, vertexCount, where);
+      return;
+    }
+    // Triangles placed more than once are read once, in object space, and placed by the node's
+    // transform; the rest are transformed into world space as they are read.
+    const std::string key = geometryKey(prim);
+    const bool shared = placements_[key] > 1 && MeshInstance::placeable(world);
+    std::shared_ptr<TriangleMesh> mesh;
+    if (shared) {
+      std::shared_ptr<TriangleMesh>& cached = sharedMeshes_[key];
+      if (!cached) cached = readTriangles(prim, mode, Mat4(1.0f), where);
+      mesh = cached;
+    } else {
+      mesh = readTriangles(prim, mode, world, where);
+    }
+    if (mesh->indices.empty()) return;
+
+    result_.triangles += mesh->indices.size();
+    ++result_.primitives;
+    const int materialIndex = materialOf(prim, where);
+    const GltfSurface& surface = materials_.surface(materialIndex, !mesh->colors.empty());
+    if (surface.maxTexCoord >= mesh->texCoordSetCount())
+      fail(surface.maxTexCoordWhere, "texCoord " + std::to_string(surface.maxTexCoord) + " names TEXCOORD_" +
+                                         std::to_string(surface.maxTexCoord) + ", which " + where +
+                                         " does not have");
+    if (surface.needsTangents && mesh->tangents.empty()) mesh->generateTangents();
+    const Material* material = surface.material;
+    if (options_.materialOverride) {
+      material = options_.materialOverride;
+    } else if (materialIndex >= 0 && size_t(materialIndex) < model_.materials.size()) {
+      const auto it = options_.materialsByName.find(model_.materials[size_t(materialIndex)].name);
+      if (it != options_.materialsByName.end()) material = it->second;
+    }
+    std::optional<Mat4> toWorld;
+    if (shared && surface.opacity) {
+      // Alpha-tested triangles stay in world space: the opacity filter hashes the ray Embree hands
+      // it, which for an instance is in object space, and is the material's, not the mesh's.
+      mesh = MeshInstance(mesh.get(), world).baked();
+    } else if (shared) {
+      toWorld = world;
+    }
+    if (!shared || surface.opacity) mesh->opacity = surface.opacity;
+    scene_.meshes.push_back(
+        {std::move(mesh), material, surface.emission, surface.maps, surface.doubleSided, toWorld});
+  }
+
+  std::shared_ptr<TriangleMesh> readTriangles(const tinygltf::Primitive& prim, int mode, const Mat4& world,
+                                              const std::string& where) {
     const auto pos = prim.attributes.find("POSITION");
     if (pos == prim.attributes.end()) fail(where, "primitive has no POSITION attribute");
     size_t vertexCount = 0;
     const std::vector<float> positions =
         readFloats(pos->second, TINYGLTF_TYPE_VEC3, where + ".attributes.POSITION", vertexCount);
-    if (mode != kModeTriangles && mode != kModeStrip && mode != kModeFan) {
-      readPointsOrLines(prim, mode, world, positions, vertexCount, where);
-      return;
-    }
-
-    auto mesh = std::make_unique<TriangleMesh>();
+    auto mesh = std::make_shared<TriangleMesh>();
     mesh->name = where;
     const glm::mat3 normalMatrix = glm::transpose(glm::inverse(glm::mat3(world)));
     mesh->positions.resize(vertexCount);
@@ -768,26 +838,7 @@ class GltfImporter {
       for (size_t i = 0; i < vertexCount; ++i) order[i] = uint32_t(i);
     }
     appendTriangles(*mesh, order, mode);
-    if (mesh->indices.empty()) return;
-
-    result_.triangles += mesh->indices.size();
-    ++result_.primitives;
-    const int materialIndex = materialOf(prim, where);
-    const GltfSurface& surface = materials_.surface(materialIndex, !mesh->colors.empty());
-    if (surface.maxTexCoord >= mesh->texCoordSetCount())
-      fail(surface.maxTexCoordWhere, "texCoord " + std::to_string(surface.maxTexCoord) + " names TEXCOORD_" +
-                                         std::to_string(surface.maxTexCoord) + ", which " + where +
-                                         " does not have");
-    if (surface.needsTangents && mesh->tangents.empty()) mesh->generateTangents();
-    const Material* material = surface.material;
-    if (options_.materialOverride) {
-      material = options_.materialOverride;
-    } else if (materialIndex >= 0 && size_t(materialIndex) < model_.materials.size()) {
-      const auto it = options_.materialsByName.find(model_.materials[size_t(materialIndex)].name);
-      if (it != options_.materialsByName.end()) material = it->second;
-    }
-    mesh->opacity = surface.opacity;
-    scene_.meshes.push_back({std::move(mesh), material, surface.emission, surface.maps, surface.doubleSided});
+    return mesh;
   }
 
   static void appendTriangles(TriangleMesh& mesh, const std::vector<uint32_t>& order, int mode) {
@@ -813,7 +864,9 @@ class GltfImporter {
   GltfImport result_;
   std::set<std::string> usedOverrides_;
   std::vector<PointsOrLines> pointsAndLines_;
-  int variant_ = -1;  // index of options_.variant among the file's variants
+  int variant_ = -1;                       // index of options_.variant among the file's variants
+  std::map<std::string, int> placements_;  // geometryKey -> node uses
+  std::map<std::string, std::shared_ptr<TriangleMesh>> sharedMeshes_;  // in object space
 };
 
 }  // namespace

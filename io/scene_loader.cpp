@@ -490,7 +490,7 @@ Scene loadGltfScene(const std::string& path, const LoadOptions& load) {
   if (imported.triangles + imported.points + imported.segments == 0)
     throw InputError(path + ": the scene contains nothing to render");
   Bounds bounds;
-  for (const auto& m : scene.meshes) bounds.extend(m.mesh->bounds());
+  for (const auto& m : scene.meshes) bounds.extend(m.worldBounds());
   for (const auto& s : scene.shapes) bounds.extend(s.shape->bounds());
   scene.settings.height = 384;
   if (imported.camera) {

@@ -190,6 +190,14 @@ void ClosestHitBatch::trace(const EmbreeAccel& accel) {
     else
       rtcIntersect8(valid, accel.rtcScene(), &context, reinterpret_cast<RTCRayHit8*>(storage_.packet(k)));
   }
+  // Hits name the instance, not the mesh inside its prototype (hitGeometry).
+  if (accel.hasInstances())
+    for (size_t i = 0; i < size_; ++i) {
+      auto* p = reinterpret_cast<RTCRayHitN*>(storage_.packetOf(i));
+      RTCHitN* h = RTCRayHitN_HitN(p, n);
+      const unsigned lane = storage_.laneOf(i);
+      RTCHitN_geomID(h, n, lane) = hitGeometry(RTCHitN_geomID(h, n, lane), RTCHitN_instID(h, n, lane, 0));
+    }
 }
 
 bool ClosestHitBatch::hit(size_t i, RawHit& out) const {

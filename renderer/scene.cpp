@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <unordered_map>
+#include <unordered_set>
 
 namespace ember {
 
@@ -30,7 +32,7 @@ std::vector<CausticCaster> Scene::findCausticCasters() const {
   }
   for (const MeshEntry& entry : meshes)
     if (!entry.mesh->indices.empty() && entry.material && entry.material->hasDeltaLobes())
-      casters.push_back(boundingSphere(entry.mesh->bounds()));
+      casters.push_back(boundingSphere(entry.worldBounds()));
   return casters;
 }
 
@@ -49,6 +51,8 @@ void Scene::build() {
   static std::atomic<uint64_t> builds{0};
   buildSerial_ = ++builds;
   records_.clear();
+  instances_.clear();
+  bakedMeshes_.clear();
   meshBytes_ = 0;
   triangleLights_.clear();
   std::vector<Light*> allLights;
@@ -94,19 +98,41 @@ void Scene::build() {
     if (records_.size() <= id) records_.resize(id + 1);
     records_[id] = rec;
   }
+  std::unordered_map<const TriangleMesh*, uint32_t> prototypes;  // shared mesh -> its BVH
   for (MeshEntry& entry : meshes) {
     if (entry.mesh->indices.empty()) continue;
-    const uint32_t id = accel_->addMesh(entry.mesh.get());
-    if (records_.size() <= id) records_.resize(id + 1);
-    GeometryRecord rec{nullptr,        entry.mesh.get(),       entry.material,  nullptr,
-                       entry.emission, entry.twoSidedEmission, entry.maps.get()};
-    rec.deltaLobes = entry.material && entry.material->hasDeltaLobes();
     if (entry.maps && entry.maps->normalMap && entry.mesh->tangents.empty()) entry.mesh->generateTangents();
-    if (!isBlack(entry.emission)) {
+    const bool emits = !isBlack(entry.emission);
+    // The mesh as traced: the entry's own, or, for an emissive instance, whose every world triangle
+    // is a light, a world-space copy.
+    const TriangleMesh* mesh = entry.mesh.get();
+    const MeshInstance* instance = nullptr;
+    bool newData = true;  // whether this mesh's bytes are not counted yet
+    uint32_t id;
+    if (entry.toWorld && emits) {
+      bakedMeshes_.push_back(MeshInstance(mesh, *entry.toWorld).baked());
+      mesh = bakedMeshes_.back().get();
+      id = accel_->addMesh(mesh);
+    } else if (entry.toWorld) {
+      const auto [it, first] = prototypes.try_emplace(mesh, 0u);
+      if (first) it->second = accel_->addPrototype(mesh);
+      instances_.push_back(std::make_unique<MeshInstance>(mesh, *entry.toWorld));
+      instance = instances_.back().get();
+      id = accel_->addInstance(it->second, *entry.toWorld);
+      newData = first;
+    } else {
+      id = accel_->addMesh(mesh);
+    }
+    if (records_.size() <= id) records_.resize(id + 1);
+    GeometryRecord rec{nullptr,         mesh, entry.material, nullptr, entry.emission, entry.twoSidedEmission,
+                       entry.maps.get()};
+    rec.instance = instance;
+    rec.deltaLobes = entry.material && entry.material->hasDeltaLobes();
+    if (emits) {
       // Every triangle of an emissive mesh is a light of its own, chosen by power like the rest.
       rec.firstTriangleLight = int64_t(triangleLights_.size());
-      for (uint32_t prim = 0; prim < entry.mesh->indices.size(); ++prim) {
-        lights.push_back(std::make_unique<TriangleLight>(entry.mesh.get(), prim, entry.emission,
+      for (uint32_t prim = 0; prim < mesh->indices.size(); ++prim) {
+        lights.push_back(std::make_unique<TriangleLight>(mesh, prim, entry.emission,
                                                          entry.maps ? entry.maps->emission.get() : nullptr,
                                                          entry.twoSidedEmission));
         allLights.push_back(lights.back().get());
@@ -114,7 +140,8 @@ void Scene::build() {
       }
     }
     records_[id] = rec;
-    const TriangleMesh& m = *entry.mesh;
+    if (!newData) continue;
+    const TriangleMesh& m = *mesh;
     meshBytes_ += m.indices.size() * sizeof(m.indices[0]) + m.positions.size() * sizeof(m.positions[0]) +
                   m.normals.size() * sizeof(m.normals[0]) + m.uvs.size() * sizeof(m.uvs[0]) +
                   m.tangents.size() * sizeof(m.tangents[0]);
@@ -185,12 +212,15 @@ void Scene::surfaceHit(const Ray& ray, const RawHit& raw, SurfaceHit& hit) const
     hit.ns = raw.ng;  // every analytic shape is shaded with its geometric normal
     hit.attributes = nullptr;
   } else {
-    hit.p = rec.mesh->pointAt(raw.primID, raw.uv.x, raw.uv.y);
-    hit.pError = rec.mesh->pointError(raw.primID);
-    const TriangleMesh::Surface s = rec.mesh->surfaceAt(raw.primID, raw.uv.x, raw.uv.y);
+    const MeshInstance* instance = rec.instance;
+    hit.p = instance ? instance->pointAt(raw.primID, raw.uv.x, raw.uv.y)
+                     : rec.mesh->pointAt(raw.primID, raw.uv.x, raw.uv.y);
+    hit.pError = instance ? instance->pointError(raw.primID) : rec.mesh->pointError(raw.primID);
+    const TriangleMesh::Surface s = instance ? instance->surfaceAt(raw.primID, raw.uv.x, raw.uv.y)
+                                             : rec.mesh->surfaceAt(raw.primID, raw.uv.x, raw.uv.y);
     hit.ng = s.ng;
     hit.uv = s.uv;
-    hit.attributes = rec.mesh;
+    hit.attributes = instance ? static_cast<const VertexAttributes*>(instance) : rec.mesh;
     hit.prim = raw.primID;
     hit.bary = raw.uv;
     Vec3 ns = s.ns;
@@ -239,6 +269,18 @@ size_t Scene::triangleCount() const {
   size_t n = 0;
   for (const MeshEntry& m : meshes) n += m.mesh->indices.size();
   return n;
+}
+
+size_t Scene::uniqueTriangleCount() const {
+  std::unordered_set<const TriangleMesh*> seen;
+  size_t n = 0;
+  for (const MeshEntry& m : meshes)
+    if (seen.insert(m.mesh.get()).second) n += m.mesh->indices.size();
+  return n;
+}
+
+Bounds Scene::MeshEntry::worldBounds() const {
+  return toWorld ? MeshInstance(mesh.get(), *toWorld).bounds() : mesh->bounds();
 }
 
 }  // namespace ember

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "accel/embree_accel.h"
+#include "accel/mesh_instance.h"
 #include "core/surface_hit.h"
 #include "materials/material.h"
 #include "materials/surface_maps.h"
@@ -48,11 +49,17 @@ class Scene {
     bool twoSidedEmission = false;  // emits on both sides, not only on the side of its normal
   };
   struct MeshEntry {
-    std::unique_ptr<TriangleMesh> mesh;
+    // Shared where one mesh is placed several times (a glTF mesh used by several nodes).
+    std::shared_ptr<TriangleMesh> mesh;
     const Material* material = nullptr;
     Color emission{0.0f};
     std::shared_ptr<const SurfaceMaps> maps;  // normal map, emissive texture; null = none
     bool twoSidedEmission = false;            // glTF doubleSided: both faces emit
+    // Unset: the mesh is in world space. Set: the mesh is in its own object space, and this places
+    // it (MeshInstance::placeable must hold); build() then traces it as an Embree instance, so
+    // entries sharing a mesh share one BVH (an emissive one is baked into world space instead).
+    std::optional<Mat4> toWorld;
+    Bounds worldBounds() const;
   };
 
   // --- filled in by a loader --------------------------------------------------------------
@@ -115,7 +122,8 @@ class Scene {
   const EmbreeAccel& accel() const { return *accel_; }
   // Rays per packet of the batched kernels (EmbreeAccel::setPacketWidth): --packet-width, tests.
   void setPacketWidth(unsigned width) { accel_->setPacketWidth(width); }
-  size_t triangleCount() const;
+  size_t triangleCount() const;        // placed: what the image shows
+  size_t uniqueTriangleCount() const;  // stored: each shared mesh counted once
 
   // What surfaceHit knows of a geometry (Embree geomID) before it is hit: for loops that settle
   // hits in their own form (packet/wave_integrator.h).
@@ -127,6 +135,7 @@ class Scene {
     Color emission{0.0f};
     bool twoSidedEmission = false;
     const SurfaceMaps* maps = nullptr;
+    const MeshInstance* instance = nullptr;  // where the mesh is placed as an instance
     int64_t firstTriangleLight = -1;  // emissive meshes: index of primitive 0's light in triangleLights_
     bool readsUv = true;              // whether the material reads the hit's texture coordinates
     bool deltaLobes = false;          // the material's Material::hasDeltaLobes, asked once
@@ -141,6 +150,8 @@ class Scene {
   std::vector<const Light*> triangleLights_;
   size_t loadedLightCount_ = 0;
   std::vector<GeometryRecord> records_;  // indexed by Embree geomID
+  std::vector<std::unique_ptr<MeshInstance>> instances_;
+  std::vector<std::unique_ptr<TriangleMesh>> bakedMeshes_;  // emissive instances, in world space
   Camera camera_;
   LightSampler lightSampler_;
   const EnvironmentLight* environment_ = nullptr;

@@ -2,7 +2,7 @@
 # The whole test suite, from a fresh machine: Debian packages, a Release build (profile-guided, as
 # scripts/demo.sh builds it: cmake/Pgo.cmake) and every test
 # (unit, statistical, whole-image comparisons, MPI with 2 and 3 ranks), then an ASan+UBSan build
-# running the unit tests, then a short run of each libFuzzer target (fuzz/run.sh).
+# with Clang of the whole tree running the unit tests, then a short run of each libFuzzer target (fuzz/run.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup-deps.sh
@@ -12,9 +12,10 @@ cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DEMBER_PGO=ON >/dev/nul
 cmake --build build -j "$jobs"
 ctest --test-dir build --output-on-failure -j "$jobs"
 
+# The sanitizer build uses Clang, so that the whole tree, tests included, builds with both compilers.
 if [ "${EMBER_SKIP_SANITIZERS:-0}" != 1 ]; then
-  cmake -S . -B build-sanitize -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DEMBER_SANITIZE=ON >/dev/null
-  cmake --build build-sanitize -j "$jobs" --target ember_unit_tests ember
+  CXX=clang++-14 cmake -S . -B build-sanitize -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DEMBER_SANITIZE=ON >/dev/null
+  cmake --build build-sanitize -j "$jobs"
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
     ctest --test-dir build-sanitize --output-on-failure -j "$jobs" -L unit
 fi

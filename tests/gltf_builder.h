@@ -109,7 +109,8 @@ class GltfBuilder {
   }
 
   // A UV sphere of `rings` x `segments` quads split into triangles, centred at c.
-  int addSphere(const float c[3], float radius, int material, int rings = 96, int segments = 192) {
+  int addSphere(const float c[3], float radius, int material, int rings = 96, int segments = 192,
+                bool withTangents = false) {
     std::vector<Vertex> v;
     std::vector<uint32_t> idx;
     for (int i = 0; i <= rings; ++i)
@@ -121,7 +122,7 @@ class GltfBuilder {
         Vertex vert{{c[0] + radius * n[0], c[1] + radius * n[1], c[2] + radius * n[2]},
                     {n[0], n[1], n[2]},
                     {float(j) / float(segments), float(i) / float(rings)},
-                    {0, 0, 0, 1}};
+                    {-std::sin(phi), 0.0f, -std::cos(phi), 1.0f}};  // along +u: d(position)/d(phi)
         v.push_back(vert);
       }
     for (int i = 0; i < rings; ++i)
@@ -129,7 +130,7 @@ class GltfBuilder {
         const uint32_t a = uint32_t(i * (segments + 1) + j), b = a + uint32_t(segments + 1);
         idx.insert(idx.end(), {a, b, a + 1, a + 1, b, b + 1});
       }
-    return addMesh(v, idx, material);
+    return addMesh(v, idx, material, withTangents);
   }
 
   int addCamera(const tinygltf::Camera& camera, const std::vector<double>& translation) {

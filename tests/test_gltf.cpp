@@ -70,7 +70,7 @@ TEST(Gltf, SharedModelsLoadWithTheirGeometry) {
     EXPECT_EQ(imported.triangles, m.triangles) << m.file;
     EXPECT_EQ(imported.camera.has_value(), m.hasCamera) << m.file;
     Bounds b;
-    for (const auto& mesh : scene.meshes) b.extend(mesh.mesh->bounds());
+    for (const auto& mesh : scene.meshes) b.extend(mesh.worldBounds());
     for (int a = 0; a < 3; ++a) {
       EXPECT_NEAR(b.lower[a], m.lower[a], 1e-3) << m.file << " axis " << a;
       EXPECT_NEAR(b.upper[a], m.upper[a], 1e-3) << m.file << " axis " << a;
@@ -119,7 +119,7 @@ TEST(Gltf, MeshEntryInJsonSceneAppliesTransform) {
   ASSERT_FALSE(scene.meshes.empty());
   Bounds b;
   for (const auto& m : scene.meshes) {
-    b.extend(m.mesh->bounds());
+    b.extend(m.worldBounds());
     EXPECT_EQ(m.material, scene.materials[0].get());  // the override
   }
   EXPECT_NEAR(b.lower.x, 9.0f, 1e-4f);
