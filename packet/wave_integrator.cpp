@@ -343,13 +343,15 @@ void WaveIntegrator::renderTile(const Scene& scene, const TileWork& work, Film& 
         if (prefetch) prefetchGroupedHits(scene, wave.closest, wave.groups, o, active);
         const size_t s = wave.groups.order()[o];
         const int32_t owner = paths.owner[s];
-        PathState path = gather(s);
         RawHit raw;
         if (!wave.closest.hit(s, raw)) {
+          if (!scene.environment()) return;  // onMiss adds the environment, and nothing else
+          PathState path = gather(s);
           path_.onMiss(scene, path);
           wave.radiance[size_t(owner)] = path.radiance;
           return;
         }
+        PathState path = gather(s);
         SurfaceHit& hit = wave.hit[vertices];
         scene.surfaceHit(path.ray, raw, hit);
         const bool scatters = path_.arrive(scene, path, hit, stats);
