@@ -12,6 +12,11 @@ are those Cycles renders opaque (alpha > 0.99 with a transparent film). Cycles: 
 width 1, no adaptive sampling, no denoiser, 1024 bounces of every kind. Prints a Markdown table
 and writes a side-by-side PNG per model (Ember left, Cycles right, the same exposure) to --out.
 Blender 3.4's Principled BSDF is not the glTF BRDF, so ratios near 1 are plausibility, not proof.
+
+--timing compares speed instead (issue 44's method): each model rendered by both at 1 spp and at
+--spp, one after the other; the time per sample pass is (wall at --spp - wall at 1) / (--spp - 1),
+so that loading, BVH builds and Blender's scene sync cancel out, and the table gives samples/s and
+their ratio, Ember / Cycles.
 """
 import argparse
 import json
@@ -66,53 +71,81 @@ def main():
     ap.add_argument("--out", default="/tmp/ember-cycles")
     ap.add_argument("--single-scatter", action="store_true",
                     help="Cycles' Principled BSDFs with single-scattering GGX, as glTF's Appendix B")
+    ap.add_argument("--timing", action="store_true", help="samples/s at 1 and --spp spp instead of the means")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
+    if args.timing:
+        timing(args)
+        return
 
     rows = []
     for model in args.models:
         name = os.path.splitext(os.path.basename(model))[0]
-        lower, upper = bounds_of(args.ember, model)
-        origin, target = framing_camera(lower, upper, args.width / args.height)
-        scene = {
-            "image": {"width": args.width, "height": args.height},
-            "camera": {"origin": origin, "target": target, "up": [0, 1, 0], "fov_y_deg": 40.0},
-            "render": {"background": [1, 1, 1]},
-            "shapes": [{"type": "mesh", "file": os.path.abspath(model)}],
-        }
-        scene_path = os.path.join(args.out, name + ".json")
-        with open(scene_path, "w") as f:
-            json.dump(scene, f)
-        ember_exr = os.path.join(args.out, name + "-ember.exr")
-        t = time.perf_counter()
-        subprocess.run([args.ember, "render", scene_path, "-o", ember_exr, "--spp", str(args.spp),
-                        "--threads", str(args.threads), "-q"], check=True, capture_output=True)
-        ember_s = time.perf_counter() - t
-        job = {"model": os.path.abspath(model), "origin": origin, "target": target, "spp": args.spp,
-               "width": args.width, "height": args.height, "threads": args.threads,
-               "cycles_exr": os.path.join(args.out, name + "-cycles.exr"), "ember_exr": ember_exr,
-               "png": os.path.join(args.out, name + ".png"), "single_scatter": args.single_scatter}
-        job_path = os.path.join(args.out, name + "-job.json")
-        with open(job_path, "w") as f:
-            json.dump(job, f)
-        t = time.perf_counter()
-        run = subprocess.run([args.blender, "-b", "--factory-startup", "-P", os.path.join(HERE, "cycles_render.py"),
-                              "--", job_path], capture_output=True, text=True, env=blender_env())
-        cycles_s = time.perf_counter() - t
-        m = re.search(r"^RESULT (.*)$", run.stdout, re.M)
-        if not m:
-            print(f"{name}: Blender failed:\n{run.stdout[-3000:]}\n{run.stderr[-3000:]}", file=sys.stderr)
-            continue
-        result = json.loads(m.group(1))
-        result.update(name=name, ember_s=ember_s, cycles_s=cycles_s)
-        rows.append(result)
-        print(json.dumps(result), file=sys.stderr)
+        result = render_both(args, model, name, args.spp)
+        if result:
+            rows.append(result)
+            print(json.dumps(result), file=sys.stderr)
 
     print("| model | Ember / Cycles mean (R, G, B) | model pixels | Ember s | Cycles s |")
     print("|---|---|---|---|---|")
     for r in rows:
         ratio = ", ".join(f"{x:.2f}" for x in r["ratio"])
         print(f"| {r['name']} | {ratio} | {r['pixels']} | {r['ember_s']:.1f} | {r['cycles_s']:.1f} |")
+
+
+def timing(args):
+    print("| model | Ember Msamples/s | Cycles Msamples/s | Ember / Cycles |")
+    print("|---|---|---|---|")
+    pixels = args.width * args.height
+    for model in args.models:
+        name = os.path.splitext(os.path.basename(model))[0]
+        one = render_both(args, model, name, 1)
+        many = render_both(args, model, name, args.spp)
+        if not one or not many:
+            continue
+        per_pass = {k: (many[k] - one[k]) / (args.spp - 1) for k in ("ember_s", "cycles_s")}
+        rate = {k: pixels / max(v, 1e-9) / 1e6 for k, v in per_pass.items()}
+        print(f"| {name} | {rate['ember_s']:.2f} | {rate['cycles_s']:.2f} | "
+              f"{rate['ember_s'] / rate['cycles_s']:.2f}x |", flush=True)
+        print(json.dumps({"name": name, "one": one, "many": many, "spp": args.spp}), file=sys.stderr)
+
+
+def render_both(args, model, name, spp):
+    """Renders the model with Ember, then with Cycles, at `spp`; their wall times and the means."""
+    lower, upper = bounds_of(args.ember, model)
+    origin, target = framing_camera(lower, upper, args.width / args.height)
+    scene = {
+        "image": {"width": args.width, "height": args.height},
+        "camera": {"origin": origin, "target": target, "up": [0, 1, 0], "fov_y_deg": 40.0},
+        "render": {"background": [1, 1, 1]},
+        "shapes": [{"type": "mesh", "file": os.path.abspath(model)}],
+    }
+    scene_path = os.path.join(args.out, name + ".json")
+    with open(scene_path, "w") as f:
+        json.dump(scene, f)
+    ember_exr = os.path.join(args.out, name + "-ember.exr")
+    t = time.perf_counter()
+    subprocess.run([args.ember, "render", scene_path, "-o", ember_exr, "--spp", str(spp),
+                    "--threads", str(args.threads), "-q"], check=True, capture_output=True)
+    ember_s = time.perf_counter() - t
+    job = {"model": os.path.abspath(model), "origin": origin, "target": target, "spp": spp,
+           "width": args.width, "height": args.height, "threads": args.threads,
+           "cycles_exr": os.path.join(args.out, name + "-cycles.exr"), "ember_exr": ember_exr,
+           "png": os.path.join(args.out, name + ".png"), "single_scatter": args.single_scatter}
+    job_path = os.path.join(args.out, name + "-job.json")
+    with open(job_path, "w") as f:
+        json.dump(job, f)
+    t = time.perf_counter()
+    run = subprocess.run([args.blender, "-b", "--factory-startup", "-P", os.path.join(HERE, "cycles_render.py"),
+                          "--", job_path], capture_output=True, text=True, env=blender_env())
+    cycles_s = time.perf_counter() - t
+    m = re.search(r"^RESULT (.*)$", run.stdout, re.M)
+    if not m:
+        print(f"{name}: Blender failed:\n{run.stdout[-3000:]}\n{run.stderr[-3000:]}", file=sys.stderr)
+        return None
+    result = json.loads(m.group(1))
+    result.update(name=name, ember_s=ember_s, cycles_s=cycles_s)
+    return result
 
 
 if __name__ == "__main__":

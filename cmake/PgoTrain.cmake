@@ -2,11 +2,11 @@
 # the shipped scenes other than the four benchmark scenes, which together use every analytic
 # shape, material and emitter type, textures and normal maps, glTF meshes, point, spot and
 # directional lights (courtyard.json, gltf-mixed.json), an environment map and the caustic light
-# tracer (demo.json, by default), then the demo again with the path tracer alone. Those scenes
-# take the wavefront kernel; terrace.json, which the default lane kernel covers (every analytic
-# shape, diffuse, textured, mirror and glass materials, every light kind), trains that kernel,
-# with caustics light-traced and path-traced. Untrained, GCC compiles the lane kernel as cold
-# code (optimised for size, split from the hot text), which cost a fifth of its speed.
+# tracer (demo.json, by default), then the demo again with the path tracer alone, and
+# terrace.json (every analytic shape, diffuse, textured, mirror and glass materials, every light
+# kind: the wave driver's Lambertian run kernel) with caustics light-traced and path-traced. All
+# of them take the wave driver. Untrained, GCC compiled the driver's kernels as cold code
+# (optimised for size, split from the hot text), which cost a fifth of their speed.
 # One thread: the counters then see the same work whatever the machine.
 # Run as: cmake -DEMBER=<instrumented ember> -DSOURCE=<source dir> -DOUT=<scratch dir> -P PgoTrain.cmake
 foreach(var EMBER SOURCE OUT)

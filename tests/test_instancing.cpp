@@ -62,7 +62,9 @@ std::string writeSpheres(const std::string& name, bool shared, bool emissive = f
     n.rotation = kPlacements[i].rotation;
     n.scale = kPlacements[i].scale;
   }
-  const std::string path = (std::filesystem::temp_directory_path() / name).string();
+  // ctest runs the tests as processes side by side: each writes files of its own.
+  const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  const std::string path = (std::filesystem::temp_directory_path() / (test + "_" + name)).string();
   EXPECT_TRUE(b.write(path));
   return path;
 }
