@@ -13,7 +13,7 @@
 // therefore not be copied or moved: a moved-from object would keep its id with other contents.
 //
 // Slots are direct-mapped by the hit's address: the wave's vertices have their hits side by side
-// (packet/wavefront_integrator.cpp), so each keeps its slot between the bounce's passes; any other
+// (packet/wave_integrator.cpp), so each keeps its slot between the bounce's passes; any other
 // hit finds a different key and computes. Per thread: no locks, nothing allocated per sample.
 #pragma once
 

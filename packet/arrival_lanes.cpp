@@ -62,11 +62,11 @@ size_t ArriveLambertianKernel(const HitFields& hits, const PathArrays& paths, co
     hn::CompressStore(hn::Add(firstVertex, hn::Iota(di, int32_t(i))), far, di, project + projected);
     projected += hn::CountTrue(di, far);
 
-    // No light sample yet; a Lambertian vertex is no Dirac one; the path's state.
+    // No light sample yet; a Lambertian vertex is in the kernels' own form; the path's state.
     store(hn::Set(d, -1.0f), nee.lightPdf);
     storeI(hn::Zero(di), nee.pointLight);
     storeI(hn::Zero(di), nee.infinite);
-    storeI(hn::Zero(di), cont.dirac);
+    storeI(hn::Zero(di), cont.general);
     storeI(hn::Zero(di), cont.sampledDelta);
     store(path(paths.etaProduct), cont.etaProduct);
     storeI(pathI(paths.owner), cont.owner);

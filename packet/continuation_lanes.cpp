@@ -37,7 +37,7 @@ size_t ContinuationKernel(const NextEventArrays& v, const ContinuationArrays& c,
   size_t count = 0;
   for (size_t i = 0; i < n; i += hn::Lanes(d)) {
     const auto load = [&](const float* row) { return hn::Load(d, row + i); };
-    const M dirac = isSet(c.dirac, i);
+    const M general = isSet(c.general, i);
     const V wi[3] = {load(c.wi[0]), load(c.wi[1]), load(c.wi[2])};
     const V ng[3] = {load(v.ng[0]), load(v.ng[1]), load(v.ng[2])};
     const V wo[3] = {load(v.wo[0]), load(v.wo[1]), load(v.wo[2])};
@@ -46,16 +46,17 @@ size_t ContinuationKernel(const NextEventArrays& v, const ContinuationArrays& c,
     const V cosWo = hn::Add(hn::Add(hn::Mul(wo[0], ng[0]), hn::Mul(wo[1], ng[1])), hn::Mul(wo[2], ng[2]));
     const V pdf = load(c.pdf);
     const M lambertianSampled = hn::AndNot(hn::Le(pdf, zero), hn::Gt(hn::Mul(cosWo, cosine), zero));
-    const M sampled = hn::Or(hn::And(dirac, isSet(c.diracSampled, i)), hn::AndNot(dirac, lambertianSampled));
+    const M sampled =
+        hn::Or(hn::And(general, isSet(c.generalSampled, i)), hn::AndNot(general, lambertianSampled));
     // The throughput times the sample's weight; the path ends without a sample or where it is black.
     V tp[3];
     for (int k = 0; k < 3; ++k)
-      tp[k] = hn::Mul(load(v.throughput[k]), hn::IfThenElse(dirac, load(c.weight[k]), load(v.albedo[k])));
+      tp[k] = hn::Mul(load(v.throughput[k]), hn::IfThenElse(general, load(c.weight[k]), load(v.albedo[k])));
     const M black = hn::And(hn::And(hn::Eq(tp[0], zero), hn::Eq(tp[1], zero)), hn::Eq(tp[2], zero));
     M alive = hn::And(hn::FirstN(d, n - i), hn::AndNot(black, sampled));
     // The eta product, then Russian roulette from rrDepth: the path goes on with probability
     // q = min(maxComponent(throughput) * eta * eta, 0.95), its throughput divided by q.
-    const V eta = hn::Mul(load(c.etaProduct), hn::IfThenElse(dirac, load(c.eta), hn::Set(d, 1.0f)));
+    const V eta = hn::Mul(load(c.etaProduct), hn::IfThenElse(general, load(c.eta), hn::Set(d, 1.0f)));
     const auto depth = hn::Load(di, c.depth + i);
     const M plays = hn::RebindMask(d, hn::Not(hn::Lt(depth, hn::Set(di, rrDepth))));  // depth >= rrDepth
     const V q = stdMin(hn::Mul(hn::Mul(stdMax(tp[0], stdMax(tp[1], tp[2])), eta), eta), hn::Set(d, 0.95f));

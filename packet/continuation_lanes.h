@@ -41,16 +41,17 @@ struct PathArrays {
 // the paths written): they must hold finite values, as the arrays start.
 struct ContinuationArrays {
   static constexpr size_t kStride = NextEventArrays::kStride;
-  // The BSDF sample's direction and density. A Lambertian vertex's come from the cosine kernel; a
-  // Dirac vertex (-1 in `dirac`) has its weight, eta, Dirac flag and whether it sampled at all (-1
-  // in `diracSampled`) from its material, where a Lambertian one's are its reflectance
-  // (NextEventArrays::albedo), 1, 0 and Lambertian::sample's test (a density, and wi on wo's side).
+  // The BSDF sample's direction and density. A vertex in the kernels' Lambertian form has them
+  // from the cosine kernel; a general vertex (-1 in `general`: any other material) has its weight,
+  // eta, Dirac flag and whether it sampled at all (-1 in `generalSampled`) from its material, where
+  // a Lambertian one's are its reflectance (NextEventArrays::albedo), 1, 0 and Lambertian::sample's
+  // test (a density, and wi on wo's side).
   alignas(64) float wi[3][kStride] = {};
   alignas(64) float pdf[kStride] = {};
-  alignas(64) int32_t dirac[kStride] = {};
+  alignas(64) int32_t general[kStride] = {};
   alignas(64) float weight[3][kStride] = {};
   alignas(64) float eta[kStride] = {};
-  alignas(64) int32_t diracSampled[kStride] = {};
+  alignas(64) int32_t generalSampled[kStride] = {};
   alignas(64) int32_t sampledDelta[kStride] = {};  // -1: the sample is a Dirac lobe's
   // The path at the vertex: its eta product, camera sample, depth and first-bounce flag, and the
   // surface's Embree masks for rays leaving to its front and back (SurfaceHit::maskFor).

@@ -1,5 +1,5 @@
 // Software prefetch for the bounce loops that settle a batch's hits in grouped order
-// (packet/wavefront_integrator.cpp, packet/caustic_wave.cpp). On a large triangle mesh,
+// (packet/wave_integrator.cpp, packet/caustic_wave.cpp). On a large triangle mesh,
 // Scene::surfaceHit's loads of a triangle's indices and then of its vertices miss the caches:
 // `perf annotate` put 65% of its time on those two loads on the million-triangle scaling scene.
 #pragma once

@@ -1,5 +1,5 @@
 // Ray packets' fields written from rows (structure of arrays) as whole vector moves. A batch's
-// rays are kept in rows by the lane kernels and copied into Embree's packets just before each
+// rays are kept in rows by the wave driver and copied into Embree's packets just before each
 // trace (ClosestHitBatch::assign): field by field, a packet's 8 or 16 lanes are one row's next 8
 // or 16 entries. Written with Highway rather than memcpy, which GCC expanded as `rep movsl` in
 // the profile-guided link (3% of a render, `perf annotate` on cornell-area, Zen 4).

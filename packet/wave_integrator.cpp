@@ -31,7 +31,7 @@ namespace {
 // One thread's wave, allocated on its first tile and reused: the bounce allocates nothing.
 // Three index spaces: camera samples (i, the wave's lanes), paths in flight (slot s, compacted
 // after every bounce) and the bounce's scattering vertices (v, in geometry order).
-struct LaneWave {
+struct Wave {
   static constexpr size_t kSize = WaveIntegrator::kWaveSize;
   static_assert(kSize <= GeometryGroups::kMaxLanes);
   static_assert(kSize <= NextEventArrays::kCapacity);
@@ -196,9 +196,9 @@ void samplePointLight(const PointLight& light, const uint64_t* keys, size_t n, N
 // sample keeps lightPdf -1. Never inlined, so that the lights' small helpers inline into it: as
 // part of renderLanes, which is large, GCC's profile-guided link once left them calls (3% of
 // cornell-area's render).
-[[gnu::noinline]] void sampleLights(LaneWave& wave, size_t queries, size_t lights) {
+[[gnu::noinline]] void sampleLights(Wave& wave, size_t queries, size_t lights) {
   const auto keys = wave.queryKey.begin(), keysEnd = keys + ptrdiff_t(queries);
-  if (lights <= LaneWave::kSize / SolidAngleLanes::kMaxLanes && !std::is_sorted(keys, keysEnd))
+  if (lights <= Wave::kSize / SolidAngleLanes::kMaxLanes && !std::is_sorted(keys, keysEnd))
     std::sort(keys, keysEnd);
   for (size_t first = 0; first < queries;) {
     const Light* light = wave.light[wave.queryKey[first] & 0xffffu];
@@ -221,9 +221,9 @@ void samplePointLight(const PointLight& light, const uint64_t* keys, size_t n, N
 
 // Samples the general vertices' lights (Light::sampleLanes, one call per run of a light) into
 // LightSamples, for PathIntegrator::shadowFor; sorted by light as sampleLights sorts.
-void sampleGeneralLights(LaneWave& wave, size_t queries, size_t lights) {
+void sampleGeneralLights(Wave& wave, size_t queries, size_t lights) {
   const auto keys = wave.generalKey.begin(), keysEnd = keys + ptrdiff_t(queries);
-  if (lights <= LaneWave::kSize / SolidAngleLanes::kMaxLanes && !std::is_sorted(keys, keysEnd))
+  if (lights <= Wave::kSize / SolidAngleLanes::kMaxLanes && !std::is_sorted(keys, keysEnd))
     std::sort(keys, keysEnd);
   for (size_t q = 0; q < queries; ++q) {
     const size_t v = wave.generalKey[q] & 0xffffu;
@@ -250,7 +250,7 @@ void WaveIntegrator::traceCaustics(const Scene& scene, uint64_t seed, SamplerTyp
 
 void WaveIntegrator::renderTile(const Scene& scene, const TileWork& work, Film& film,
                                 PathStats& stats) const {
-  LaneWave& wave = threadWave<LaneWave>();
+  Wave& wave = threadWave<Wave>();
   NextEventArrays& nee = wave.nee;
   wave.closest.setWidth(scene.accel().packetWidth());
   wave.shadows.setWidth(scene.accel().packetWidth());
@@ -264,8 +264,8 @@ void WaveIntegrator::renderTile(const Scene& scene, const TileWork& work, Film& 
   // Camera sample k of the tile is pixel k % pixels (row by row) of sample k / pixels; the wave
   // steps through them in that order, counting instead of dividing.
   int x = work.x0, y = work.y0, sample = 0;
-  for (uint64_t first = 0; first < total; first += LaneWave::kSize) {
-    const size_t count = size_t(std::min<uint64_t>(LaneWave::kSize, total - first));
+  for (uint64_t first = 0; first < total; first += Wave::kSize) {
+    const size_t count = size_t(std::min<uint64_t>(Wave::kSize, total - first));
     PhaseClock phases(work.timePhases, stats.phaseNanoseconds);
     for (size_t i = 0; i < count; ++i) {
       wave.x[i] = x;
@@ -362,7 +362,7 @@ void WaveIntegrator::renderTile(const Scene& scene, const TileWork& work, Film& 
         const bool inline_ = hit.material->lambertianAt(hit, reflectance);
         wave.general[v] = inline_ ? nullptr : hit.material;
         if (inline_) store3(nee.albedo, v, reflectance);
-        cont.dirac[v] = inline_ ? 0 : -1;
+        cont.general[v] = inline_ ? 0 : -1;
         wave.bsdfUse[v] = RequestUse{hit.material->usesDirectionSample(), hit.material->usesLobeSample()};
         if (path_.samplesLights(scene, hit)) wave.lightVertex[lightDraws++] = uint16_t(v);
         store3(nee.p, v, hit.p);
@@ -516,7 +516,7 @@ void WaveIntegrator::renderTile(const Scene& scene, const TileWork& work, Film& 
       for (size_t g = 0; g < generals; ++g) {
         const size_t v = wave.generalVertex[g];
         const bool sampled = wave.bsdfs.sampled[g];
-        cont.diracSampled[v] = sampled ? -1 : 0;
+        cont.generalSampled[v] = sampled ? -1 : 0;
         if (!sampled) continue;
         const BsdfSample& bs = wave.bsdfs.sample[g];
         store3(cont.wi, v, bs.wi);

@@ -1,5 +1,5 @@
 // Camera::generateRay's directions for many camera samples at once (the lane kernel's camera rays,
-// packet/lane_integrator.cpp), in Highway vectors: the raster position, the point on the image
+// packet/wave_integrator.cpp), in Highway vectors: the raster position, the point on the image
 // plane and glm::normalize's 1 / sqrt, with the scalar code's float operations in their order
 // (this file is compiled without fused multiply-adds; square root and division round exactly), so
 // each lane equals the scalar ray bit for bit (tests/test_wavefront.cpp).

@@ -1,5 +1,5 @@
 // The steps a path tracer takes per bounce, as the batched kernels run them one after another for
-// a whole wave (packet/wavefront_integrator.cpp), and a clock that charges the time between its
+// a whole wave (packet/wave_integrator.cpp), and a clock that charges the time between its
 // marks to them: `ember bench --phases` reports where a render's time goes by step, the measure
 // the structure-of-arrays plan (docs/architecture.md) predicts and checks its stages with.
 #pragma once

@@ -1,5 +1,5 @@
 // The Sobol sampler's requests for many samplers at once (a bounce of a wave,
-// packet/wavefront_integrator.cpp): each sampler's next 1D or 2D request, exactly the value its
+// packet/wave_integrator.cpp): each sampler's next 1D or 2D request, exactly the value its
 // get1D / get2D would return. The Owen-scrambling hashes (renderer/sampler.h) are integer
 // arithmetic, so the Highway kernel (32-bit lanes, the widest ISA the CPU has) equals the scalar
 // code bit for bit by construction (tests/test_sampling_lanes.cpp); requests past the Sobol
