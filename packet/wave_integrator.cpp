@@ -9,7 +9,6 @@
 #include "packet/geometry_groups.h"
 #include "packet/hit_prefetch.h"
 #include "packet/next_event_lanes.h"
-#include "packet/packet_fields.h"
 #include "packet/ray_batch.h"
 #include "packet/thread_wave.h"
 #include "packet/timed_trace.h"
@@ -97,36 +96,14 @@ std::array<const float*, 3> rowsOf(const float (&rows)[3][NextEventArrays::kStri
   return {rows[0], rows[1], rows[2]};
 }
 
-void storeSample(NextEventArrays& nee, size_t v, const LightSample& ls) {
-  store3(nee.lightP, v, ls.p);
-  store3(nee.lightN, v, ls.n);
-  store3(nee.lightWi, v, ls.wi);
-  store3(nee.lightLi, v, ls.Li);
-  nee.lightPError[v] = ls.pError;
-  nee.lightPdf[v] = ls.pdf;
-  nee.delta[v] = ls.delta ? -1 : 0;
-  nee.infinite[v] = std::isfinite(ls.dist) ? 0 : -1;
-}
-
-// Light queries are kept as keys (a light's index << 16 | vertex). Within a light's run they rise
-// with the vertex, and one shape's vertices are consecutive, so most of a run falls into blocks of
-// kSampleBlock queries on consecutive vertices, which read and write the next-event rows as whole
-// vectors. (Any order is correct; a block is found only where the keys rise one by one.)
-constexpr size_t kSampleBlock = SolidAngleLanes::kMaxLanes;
-bool consecutiveBlock(const uint64_t* keys, size_t q, size_t n) {
-  if (q + kSampleBlock > n) return false;
-  for (size_t i = 1; i < kSampleBlock; ++i)
-    if (keys[q + i] != keys[q] + i) return false;
-  return true;
-}
-
-// An area light's samples for the vertices `keys` name (their low 16 bits), read from
-// and written to the next-event arrays; a vertex without a sample keeps lightPdf -1. Blocks of
-// queries on consecutive vertices (the vertices of one shape's run are consecutive) take
-// AreaLight::sampleRows, which reads and writes the rows as whole vectors; the rest take
-// sampleBlocks, lane by lane.
-void sampleAreaLight(const AreaLight& light, const uint64_t* keys, size_t n, NextEventArrays& nee,
-                     const Vec2* lightU) {
+// Samples every vertex's chosen light, one run of queries per light (sorted by light where that
+// makes runs), into the next-event arrays: each light's Light::sampleRun, PathIntegrator's light
+// sample in row form. A vertex without a sample keeps lightPdf -1.
+[[gnu::noinline]] void sampleLights(Wave& wave, size_t queries, size_t lights) {
+  const auto keys = wave.queryKey.begin(), keysEnd = keys + ptrdiff_t(queries);
+  if (lights <= Wave::kSize / SolidAngleLanes::kMaxLanes && !std::is_sorted(keys, keysEnd))
+    std::sort(keys, keysEnd);
+  NextEventArrays& nee = wave.nee;
   const float* const refRows[3] = {nee.p[0], nee.p[1], nee.p[2]};
   const LightSampleRows rows{{nee.lightP[0], nee.lightP[1], nee.lightP[2]},
                              {nee.lightN[0], nee.lightN[1], nee.lightN[2]},
@@ -135,86 +112,13 @@ void sampleAreaLight(const AreaLight& light, const uint64_t* keys, size_t n, Nex
                              nee.lightPError,
                              nee.lightPdf,
                              nee.delta,
-                             nee.infinite};
-  const auto consecutive = [&](size_t q) { return consecutiveBlock(keys, q, n); };
-  for (size_t q = 0; q < n;) {
-    size_t end = q;
-    while (end < n && !consecutive(end)) ++end;
-    if (end > q)
-      light.sampleBlocks(
-          end - q, [&](size_t i) { return load3(nee.p, keys[q + i] & 0xffffu); },
-          [&](size_t i) { return lightU[keys[q + i] & 0xffffu]; },
-          [&](size_t i, const LightSample& ls) { storeSample(nee, keys[q + i] & 0xffffu, ls); });
-    for (; consecutive(end); end += kSampleBlock)
-      light.sampleRows(refRows, lightU, size_t(keys[end] & 0xffffu), rows);
-    q = end;
-  }
-}
-
-// A point light's samples for the vertices `keys` name: the next-event kernel takes each from the
-// light's position and intensity (renderer/light.cpp, samplePosition), which the vertices' rows
-// repeat. A block of queries on consecutive vertices is filled as whole vectors: the rows from
-// the block's first vertex on, seen as one packet of kSampleBlock lanes (packet/packet_fields.h).
-void samplePointLight(const PointLight& light, const uint64_t* keys, size_t n, NextEventArrays& nee) {
-  const Vec3 p = light.position();
-  const Color intensity = light.intensity();
-  const auto row = [](size_t offsetInBytes, int c = 0) {
-    return offsetInBytes / sizeof(float) + size_t(c) * NextEventArrays::kStride;
-  };
-  const PacketFieldSource fields[] = {
-      {row(offsetof(NextEventArrays, lightP), 0), nullptr, p.x},
-      {row(offsetof(NextEventArrays, lightP), 1), nullptr, p.y},
-      {row(offsetof(NextEventArrays, lightP), 2), nullptr, p.z},
-      {row(offsetof(NextEventArrays, lightLi), 0), nullptr, intensity.x},
-      {row(offsetof(NextEventArrays, lightLi), 1), nullptr, intensity.y},
-      {row(offsetof(NextEventArrays, lightLi), 2), nullptr, intensity.z},
-      {row(offsetof(NextEventArrays, lightN), 0), nullptr, 0.0f},
-      {row(offsetof(NextEventArrays, lightN), 1), nullptr, 0.0f},
-      {row(offsetof(NextEventArrays, lightN), 2), nullptr, 0.0f},
-      {row(offsetof(NextEventArrays, lightPError)), nullptr, 0.0f},
-      {row(offsetof(NextEventArrays, pointLight)), nullptr, std::bit_cast<float>(int32_t(-1))}};
-  float* const rows = reinterpret_cast<float*>(&nee);
-  for (size_t q = 0; q < n;) {
-    const size_t v = keys[q] & 0xffffu;
-    if (consecutiveBlock(keys, q, n)) {
-      fillPacketFields(rows + v, /*stride=*/0, kSampleBlock, kSampleBlock, fields,
-                       std::size(fields));  // one packet
-      q += kSampleBlock;
-      continue;
-    }
-    store3(nee.lightP, v, p);
-    store3(nee.lightLi, v, intensity);
-    store3(nee.lightN, v, Vec3(0.0f));
-    nee.lightPError[v] = 0.0f;
-    nee.pointLight[v] = -1;
-    ++q;
-  }
-}
-
-// Samples every vertex's chosen light, one run of queries per light (sorted by light where that
-// makes runs; PathIntegrator's light sample), into the next-event arrays; a vertex without a
-// sample keeps lightPdf -1. Never inlined, so that the lights' small helpers inline into it: as
-// part of renderLanes, which is large, GCC's profile-guided link once left them calls (3% of
-// cornell-area's render).
-[[gnu::noinline]] void sampleLights(Wave& wave, size_t queries, size_t lights) {
-  const auto keys = wave.queryKey.begin(), keysEnd = keys + ptrdiff_t(queries);
-  if (lights <= Wave::kSize / SolidAngleLanes::kMaxLanes && !std::is_sorted(keys, keysEnd))
-    std::sort(keys, keysEnd);
+                             nee.infinite,
+                             nee.pointLight};
   for (size_t first = 0; first < queries;) {
     const Light* light = wave.light[wave.queryKey[first] & 0xffffu];
     size_t end = first + 1;
     while (end < queries && (wave.queryKey[end] >> 16) == (wave.queryKey[first] >> 16)) ++end;
-    if (const auto* area = dynamic_cast<const AreaLight*>(light)) {
-      sampleAreaLight(*area, &wave.queryKey[first], end - first, wave.nee, wave.lightU.data());
-    } else if (const auto* point = dynamic_cast<const PointLight*>(light); point && !point->ranged()) {
-      samplePointLight(*point, &wave.queryKey[first], end - first, wave.nee);
-    } else {
-      for (size_t q = first; q < end; ++q) {
-        const size_t v = wave.queryKey[q] & 0xffffu;
-        LightSample ls;
-        if (light->sample(load3(wave.nee.p, v), wave.lightU[v], ls)) storeSample(wave.nee, v, ls);
-      }
-    }
+    light->sampleRun(&wave.queryKey[first], end - first, refRows, wave.lightU.data(), rows);
     first = end;
   }
 }

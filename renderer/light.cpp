@@ -102,6 +102,91 @@ void AreaLight::sampleRows(const float* const refRows[3], const Vec2* us, size_t
   storeLightSampleRows(lanes, live, radiance_, twoSided_, pError_, rows, first);
 }
 
+namespace {
+
+// A vertex's sample into the rows: what the next-event kernel reads of a LightSample.
+void storeSample(const LightSampleRows& rows, size_t v, const LightSample& ls) {
+  for (int c = 0; c < 3; ++c) {
+    rows.p[c][v] = ls.p[c];
+    rows.n[c][v] = ls.n[c];
+    rows.wi[c][v] = ls.wi[c];
+    rows.Li[c][v] = ls.Li[c];
+  }
+  rows.pError[v] = ls.pError;
+  rows.pdf[v] = ls.pdf;
+  rows.delta[v] = ls.delta ? -1 : 0;
+  rows.infinite[v] = std::isfinite(ls.dist) ? 0 : -1;
+}
+
+// Queries are keys (a light's index << 16 | vertex), rising with the vertex within a light's run,
+// and one shape's vertices are consecutive: most of a run falls into blocks of kSampleBlock
+// queries on consecutive vertices, which read and write the rows as whole vectors. (Any order is
+// correct; a block is found only where the keys rise one by one.)
+constexpr size_t kSampleBlock = SolidAngleLanes::kMaxLanes;
+bool consecutiveBlock(const uint64_t* keys, size_t q, size_t n) {
+  if (q + kSampleBlock > n) return false;
+  for (size_t i = 1; i < kSampleBlock; ++i)
+    if (keys[q + i] != keys[q] + i) return false;
+  return true;
+}
+
+size_t vertexOf(uint64_t key) {
+  return size_t(key & 0xffffu);
+}
+
+}  // namespace
+
+void Light::sampleRun(const uint64_t* keys, size_t n, const float* const refRows[3], const Vec2* us,
+                      const LightSampleRows& rows) const {
+  for (size_t q = 0; q < n; ++q) {
+    const size_t v = vertexOf(keys[q]);
+    LightSample ls;
+    if (sample(Vec3(refRows[0][v], refRows[1][v], refRows[2][v]), us[v], ls)) storeSample(rows, v, ls);
+  }
+}
+
+void PointLight::sampleRun(const uint64_t* keys, size_t n, const float* const refRows[3], const Vec2* us,
+                           const LightSampleRows& rows) const {
+  if (ranged()) {
+    Light::sampleRun(keys, n, refRows, us, rows);
+    return;
+  }
+  const auto fill = [&](size_t first, size_t count) {
+    for (int c = 0; c < 3; ++c) {
+      std::fill_n(rows.p[c] + first, count, position_[c]);
+      std::fill_n(rows.Li[c] + first, count, intensity_[c]);
+      std::fill_n(rows.n[c] + first, count, 0.0f);
+    }
+    std::fill_n(rows.pError + first, count, 0.0f);
+    std::fill_n(rows.pointLight + first, count, -1);
+  };
+  for (size_t q = 0; q < n;) {
+    const bool block = consecutiveBlock(keys, q, n);
+    fill(vertexOf(keys[q]), block ? kSampleBlock : 1);
+    q += block ? kSampleBlock : 1;
+  }
+}
+
+void AreaLight::sampleRun(const uint64_t* keys, size_t n, const float* const refRows[3], const Vec2* us,
+                          const LightSampleRows& rows) const {
+  const auto consecutive = [&](size_t q) { return consecutiveBlock(keys, q, n); };
+  for (size_t q = 0; q < n;) {
+    size_t end = q;
+    while (end < n && !consecutive(end)) ++end;
+    if (end > q)
+      sampleBlocks(
+          end - q,
+          [&](size_t i) {
+            const size_t v = vertexOf(keys[q + i]);
+            return Vec3(refRows[0][v], refRows[1][v], refRows[2][v]);
+          },
+          [&](size_t i) { return us[vertexOf(keys[q + i])]; },
+          [&](size_t i, const LightSample& ls) { storeSample(rows, vertexOf(keys[q + i]), ls); });
+    for (; consecutive(end); end += kSampleBlock) sampleRows(refRows, us, vertexOf(keys[end]), rows);
+    q = end;
+  }
+}
+
 bool AreaLight::fromShapeSample(const Vec3& ref, const ShapeSample& s, float pdf, LightSample& out) const {
   const Vec3 d = s.p - ref;
   const float dist = glm::length(d);

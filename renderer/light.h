@@ -42,6 +42,13 @@ class Light {
   // bit. The default goes point by point; lights with a lane kernel (accel/sampling_lanes.h)
   // override it.
   virtual void sampleLanes(const Vec3* refs, const Vec2* us, size_t n, LightSample* out, bool* ok) const;
+  // The samples of a run of the wave driver's light queries, written into its rows
+  // (renderer/light_lanes.h): query i is the vertex in the low 16 bits of keys[i], whose
+  // reference point is in refRows and numbers in us, both indexed by vertex. A vertex without a
+  // sample keeps its rows as they were. The default takes sample() query by query; area and point
+  // lights fill whole blocks of consecutive vertices at once.
+  virtual void sampleRun(const uint64_t* keys, size_t n, const float* const refRows[3], const Vec2* us,
+                         const LightSampleRows& rows) const;
 
   int samplerIndex = -1;  // position in the LightSampler's table
   // The Embree ray mask of shadow rays aimed at this light: all bits but its own geometry's where
@@ -73,6 +80,10 @@ class PointLight final : public Light {
   const Color& intensity() const { return intensity_; }
   // A finite range (rangeWindow): the next-event kernel's whole-vector rows assume none.
   bool ranged() const { return range_ > 0.0f; }
+  // Position and intensity into the rows, for the next-event kernel to take the sample
+  // (LightSampleRows::pointLight); a ranged light samples query by query.
+  void sampleRun(const uint64_t* keys, size_t n, const float* const refRows[3], const Vec2* us,
+                 const LightSampleRows& rows) const override;
 
  private:
   Vec3 position_;
@@ -154,6 +165,10 @@ class AreaLight final : public Light {
   // sample()'s; a query without a sample leaves its rows untouched.
   void sampleRows(const float* const refRows[3], const Vec2* us, size_t first,
                   const LightSampleRows& rows) const;
+  // Blocks of consecutive vertices through sampleRows, the queries between them through
+  // sampleBlocks.
+  void sampleRun(const uint64_t* keys, size_t n, const float* const refRows[3], const Vec2* us,
+                 const LightSampleRows& rows) const override;
   // Lambertian emitter: Phi = pi * A * L per emitting side.
   Color power(float) const override { return (twoSided_ ? 2.0f : 1.0f) * kPi * shape_->area() * radiance_; }
   const Shape* shape() const { return shape_; }

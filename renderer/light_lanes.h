@@ -32,6 +32,9 @@ struct LightSampleRows {
   float* pdf;
   int32_t* delta;     // 0: an area light's sample is never a delta
   int32_t* infinite;  // -1 where the distance is not finite
+  // -1: the light is a point light at p with intensity Li, whose sample the next-event kernel
+  // takes itself (PointLight::sampleRun); wi, pdf and delta are then not read.
+  int32_t* pointLight;
 };
 
 // How far behind the plane (beyond the margin) a reference point must lie, per unit of its

@@ -322,7 +322,8 @@ void expectAreaLightRowsEqualSingleSamples() {
     for (Vec2& u : us) u = next2(rng);
     std::vector<float> rowData[14];
     for (auto& row : rowData) row.assign(rowSize, kUntouched);
-    std::vector<int32_t> deltaRow(rowSize, kUntouchedInt), infiniteRow(rowSize, kUntouchedInt);
+    std::vector<int32_t> deltaRow(rowSize, kUntouchedInt), infiniteRow(rowSize, kUntouchedInt),
+        pointRow(rowSize, kUntouchedInt);
     auto at = [&](int k) { return rowData[k].data(); };
     const LightSampleRows rows{{at(0), at(1), at(2)},
                                {at(3), at(4), at(5)},
@@ -331,7 +332,8 @@ void expectAreaLightRowsEqualSingleSamples() {
                                at(12),
                                at(13),
                                deltaRow.data(),
-                               infiniteRow.data()};
+                               infiniteRow.data(),
+                               pointRow.data()};
     const float* const refRows[3] = {refRow[0].data(), refRow[1].data(), refRow[2].data()};
     for (size_t first = kOffset; first < rowSize; first += kBlock)
       light.sampleRows(refRows, us.data(), first, rows);
