@@ -96,13 +96,26 @@ std::array<const float*, 3> rowsOf(const float (&rows)[3][NextEventArrays::kStri
   return {rows[0], rows[1], rows[2]};
 }
 
-// Samples every vertex's chosen light, one run of queries per light (sorted by light where that
-// makes runs), into the next-event arrays: each light's Light::sampleRun, PathIntegrator's light
-// sample in row form. A vertex without a sample keeps lightPdf -1.
+// Sorts light queries (samplerIndex << 16 | vertex) by light where that makes runs, and calls
+// sample(first, count) once per run of one light. Queries are made in vertex order, so with one
+// light (or lights met in order) they are sorted already; with more lights than a wave has vectors
+// of queries, runs would stay short, and sorting would cost more than it saves.
+template <class SampleRun>
+void forEachLightRun(uint64_t* keys, size_t queries, size_t lights, SampleRun&& sample) {
+  if (lights <= Wave::kSize / SolidAngleLanes::kMaxLanes && !std::is_sorted(keys, keys + queries))
+    std::sort(keys, keys + queries);
+  for (size_t first = 0; first < queries;) {
+    size_t end = first + 1;
+    while (end < queries && (keys[end] >> 16) == (keys[first] >> 16)) ++end;
+    sample(first, end - first);
+    first = end;
+  }
+}
+
+// Samples the chosen lights of the vertices in the kernels' Lambertian form into the next-event
+// arrays (Light::sampleRun, PathIntegrator's light sample in row form); a vertex without a sample
+// keeps lightPdf -1.
 [[gnu::noinline]] void sampleLights(Wave& wave, size_t queries, size_t lights) {
-  const auto keys = wave.queryKey.begin(), keysEnd = keys + ptrdiff_t(queries);
-  if (lights <= Wave::kSize / SolidAngleLanes::kMaxLanes && !std::is_sorted(keys, keysEnd))
-    std::sort(keys, keysEnd);
   NextEventArrays& nee = wave.nee;
   const float* const refRows[3] = {nee.p[0], nee.p[1], nee.p[2]};
   const LightSampleRows rows{{nee.lightP[0], nee.lightP[1], nee.lightP[2]},
@@ -114,34 +127,25 @@ std::array<const float*, 3> rowsOf(const float (&rows)[3][NextEventArrays::kStri
                              nee.delta,
                              nee.infinite,
                              nee.pointLight};
-  for (size_t first = 0; first < queries;) {
-    const Light* light = wave.light[wave.queryKey[first] & 0xffffu];
-    size_t end = first + 1;
-    while (end < queries && (wave.queryKey[end] >> 16) == (wave.queryKey[first] >> 16)) ++end;
-    light->sampleRun(&wave.queryKey[first], end - first, refRows, wave.lightU.data(), rows);
-    first = end;
-  }
+  const uint64_t* keys = wave.queryKey.data();
+  forEachLightRun(wave.queryKey.data(), queries, lights, [&](size_t first, size_t n) {
+    wave.light[keys[first] & 0xffffu]->sampleRun(&keys[first], n, refRows, wave.lightU.data(), rows);
+  });
 }
 
-// Samples the general vertices' lights (Light::sampleLanes, one call per run of a light) into
-// LightSamples, for PathIntegrator::shadowFor; sorted by light as sampleLights sorts.
+// Samples the general vertices' chosen lights into LightSamples (Light::sampleLanes), for
+// PathIntegrator::shadowFor.
 void sampleGeneralLights(Wave& wave, size_t queries, size_t lights) {
-  const auto keys = wave.generalKey.begin(), keysEnd = keys + ptrdiff_t(queries);
-  if (lights <= Wave::kSize / SolidAngleLanes::kMaxLanes && !std::is_sorted(keys, keysEnd))
-    std::sort(keys, keysEnd);
-  for (size_t q = 0; q < queries; ++q) {
-    const size_t v = wave.generalKey[q] & 0xffffu;
-    wave.generalRef[q] = wave.hit[v].p;
-    wave.generalU[q] = wave.lightU[v];
-  }
-  for (size_t first = 0; first < queries;) {
-    const Light* light = wave.light[wave.generalKey[first] & 0xffffu];
-    size_t end = first + 1;
-    while (end < queries && (wave.generalKey[end] >> 16) == (wave.generalKey[first] >> 16)) ++end;
-    light->sampleLanes(&wave.generalRef[first], &wave.generalU[first], end - first,
-                       &wave.generalSample[first], &wave.generalSampled[first]);
-    first = end;
-  }
+  forEachLightRun(wave.generalKey.data(), queries, lights, [&](size_t first, size_t n) {
+    for (size_t q = first; q < first + n; ++q) {
+      const size_t v = wave.generalKey[q] & 0xffffu;
+      wave.generalRef[q] = wave.hit[v].p;
+      wave.generalU[q] = wave.lightU[v];
+    }
+    wave.light[wave.generalKey[first] & 0xffffu]->sampleLanes(&wave.generalRef[first], &wave.generalU[first],
+                                                              n, &wave.generalSample[first],
+                                                              &wave.generalSampled[first]);
+  });
 }
 
 }  // namespace
@@ -249,7 +253,7 @@ void WaveIntegrator::renderTile(const Scene& scene, const TileWork& work, Film& 
         const int32_t owner = paths.owner[s];
         RawHit raw;
         if (!wave.closest.hit(s, raw)) {
-          if (!scene.environment()) return;  // onMiss adds the environment, and nothing else
+          if (!PathIntegrator::missAddsLight(scene)) return;  // no state to gather
           PathState path = gather(s);
           path_.onMiss(scene, path);
           wave.radiance[size_t(owner)] = path.radiance;

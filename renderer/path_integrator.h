@@ -85,6 +85,8 @@ class PathIntegrator final : public Integrator {
   bool start(const Ray& cameraRay, PathState& path) const;
   // The path's ray left the scene: adds the environment it sees. The path ends.
   void onMiss(const Scene& scene, PathState& path) const;
+  // Whether onMiss can add anything at all: only an environment shines on a path that leaves.
+  static bool missAddsLight(const Scene& scene) { return scene.environment() != nullptr; }
   // The path's ray found `hit`: adds its emission, asks for a shadow ray (returns true and fills
   // `shadow`) and samples the next ray into path.ray. `continues` says whether the path goes on.
   // The shadow ray's contribution must be added before the path's next step.

@@ -1,4 +1,4 @@
-// The wavefront integrator (8- and 16-wide Embree packets and ray streams, SIMD lane filters) must
+// The wave driver (8- and 16-wide Embree packets, SIMD lane filters, the bounce in arrays) must
 // produce the scalar reference's image bit for bit, for every shape, material, emitter and light
 // type, every strategy and sampler, any thread count and tile size, and images whose size is not
 // a multiple of the tile or the wave.
