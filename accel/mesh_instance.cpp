@@ -48,9 +48,9 @@ float MeshInstance::pointError(uint32_t prim) const {
 }
 
 TriangleMesh::Surface MeshInstance::surfaceAt(uint32_t prim, float b1, float b2) const {
-  TriangleMesh::Surface s = mesh_->surfaceAt(prim, b1, b2);
+  TriangleMesh::Surface s;
   // cross(M a, M b) = det(M) M^-T (a x b): the transformed triangle's normal.
-  s.ng = handedness_ * toWorldNormal(s.ng);
+  s.ng = handedness_ * toWorldNormal(mesh_->geometricNormal(prim));
   // Vertex normals transformed one by one, then interpolated, as in the copy: under a non-uniform
   // scale, transforming the interpolated normal instead tilts it by degrees on a coarse mesh.
   s.ns = s.ng;
@@ -61,7 +61,11 @@ TriangleMesh::Surface MeshInstance::surfaceAt(uint32_t prim, float b1, float b2)
     const float nl = glm::length(n);
     if (nl > 1e-6f && std::isfinite(nl)) s.ns = n / nl;  // TriangleMesh::surfaceAt's fallback
   }
-  if (!mesh_->tangents.empty()) s.tangent = glm::vec4(linear_ * Vec3(s.tangent), s.tangent.w * handedness_);
+  s.uv = mesh_->uvAt(prim, b1, b2);
+  if (!mesh_->tangents.empty()) {
+    const glm::vec4 t = mesh_->interpolatedTangent(prim, b1, b2);
+    s.tangent = glm::vec4(linear_ * Vec3(t), t.w * handedness_);
+  }
   return s;
 }
 

@@ -3,23 +3,33 @@
 namespace ember {
 
 TriangleMesh::Surface TriangleMesh::surfaceAt(uint32_t prim, float b1, float b2) const {
-  const glm::uvec3& idx = indices[prim];
-  const Vec3& p0 = positions[idx.x];
-  const Vec3 cross = glm::cross(positions[idx.y] - p0, positions[idx.z] - p0);
-  const float len = glm::length(cross);
   Surface s;
-  s.ng = len > 0.0f ? cross / len : Vec3(0.0f, 0.0f, 1.0f);
-  const float b0 = 1.0f - b1 - b2;
+  s.ng = geometricNormal(prim);
   s.ns = s.ng;
   if (!normals.empty()) {
-    const Vec3 n = b0 * normals[idx.x] + b1 * normals[idx.y] + b2 * normals[idx.z];
+    const glm::uvec3& idx = indices[prim];
+    const Vec3 n = (1.0f - b1 - b2) * normals[idx.x] + b1 * normals[idx.y] + b2 * normals[idx.z];
     const float nl = glm::length(n);
     // A degenerate interpolated normal (opposite vertex normals) falls back to flat shading.
     if (nl > 1e-6f && std::isfinite(nl)) s.ns = n / nl;
   }
   s.uv = uvAt(prim, b1, b2);
-  if (!tangents.empty()) s.tangent = b0 * tangents[idx.x] + b1 * tangents[idx.y] + b2 * tangents[idx.z];
+  s.tangent = interpolatedTangent(prim, b1, b2);
   return s;
+}
+
+Vec3 TriangleMesh::geometricNormal(uint32_t prim) const {
+  const glm::uvec3& idx = indices[prim];
+  const Vec3& p0 = positions[idx.x];
+  const Vec3 cross = glm::cross(positions[idx.y] - p0, positions[idx.z] - p0);
+  const float len = glm::length(cross);
+  return len > 0.0f ? cross / len : Vec3(0.0f, 0.0f, 1.0f);
+}
+
+glm::vec4 TriangleMesh::interpolatedTangent(uint32_t prim, float b1, float b2) const {
+  if (tangents.empty()) return glm::vec4(0.0f);
+  const glm::uvec3& idx = indices[prim];
+  return (1.0f - b1 - b2) * tangents[idx.x] + b1 * tangents[idx.y] + b2 * tangents[idx.z];
 }
 
 Vec2 TriangleMesh::uvAt(uint32_t prim, float b1, float b2) const {

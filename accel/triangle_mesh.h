@@ -54,6 +54,8 @@ struct TriangleMesh final : VertexAttributes {
   // Surface attributes at barycentrics (b1, b2) of triangle `prim`.
   Surface surfaceAt(uint32_t prim, float b1, float b2) const;
   Vec2 uvAt(uint32_t prim, float b1, float b2) const;
+  Vec3 geometricNormal(uint32_t prim) const;  // unit, (0, 0, 1) for a degenerate triangle
+  glm::vec4 interpolatedTangent(uint32_t prim, float b1, float b2) const;  // 0 without tangents
   // Texture coordinate sets beyond uvs count from 1; a set the mesh lacks reads as set 0 (the
   // loader refuses materials that name one).
   int texCoordSetCount() const { return 1 + int(texCoordSets.size()); }

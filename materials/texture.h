@@ -78,7 +78,8 @@ class ImageTexture final : public Texture {
   int bytesPerTexel() const { return !paletted_ ? 12 : colorPalette_.empty() ? 3 : 1; }
 
  private:
-  Color texel(int x, int y) const;
+  Color texel(int x, int y) const;    // (x, y) wrapped into the image first
+  Color texelAt(int x, int y) const;  // (x, y) inside the image
 
   int width_, height_;
   // Texels of at most 256 distinct values per channel (every 8-bit image, whatever its encoding)
