@@ -1,5 +1,6 @@
 #include "app/commands.h"
 
+#include "io/image_plugin.h"
 #include "io/scene_loader.h"
 
 #include <map>
@@ -76,6 +77,12 @@ Runner addInfoCommand(CLI::App& app) {
     }
     std::printf("\nbounds:     (%g, %g, %g) - (%g, %g, %g)\n", b.lower.x, b.lower.y, b.lower.z, b.upper.x,
                 b.upper.y, b.upper.z);
+    // Which reader image files go through (io/image_plugin.h); EXR and PFM are always read built in.
+    if (const ImagePlugin* plugin = imagePlugin())
+      std::printf("images:     %s\n", plugin->describe().c_str());
+    else
+      std::printf("images:     built-in readers (stb_image); no OpenImageIO plugin: %s\n",
+                  imagePluginError().c_str());
     return 0;
   };
 }

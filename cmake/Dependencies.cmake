@@ -28,3 +28,8 @@ pkg_check_modules(stb REQUIRED IMPORTED_TARGET stb)
 find_package(meshoptimizer REQUIRED CONFIG)
 find_package(draco REQUIRED CONFIG)
 pkg_check_modules(webp REQUIRED IMPORTED_TARGET libwebp)
+# OpenImageIO (libopenimageio-dev) through pkg-config: its CMake config demands openimageio-tools
+# (and Qt with it) and names a missing opencv include folder (../shared/docs/debian-toolchain.md).
+# Only the image plugin module links it (io/image_plugin.h says why); without it Ember builds and
+# reads images with its built-in readers.
+pkg_check_modules(OpenImageIO QUIET IMPORTED_TARGET OpenImageIO)

@@ -1,5 +1,6 @@
 #include "io/image_io.h"
 
+#include "io/image_plugin.h"
 #include "io/input_error.h"
 #include "io/pending_file.h"
 #include "materials/texture.h"
@@ -235,11 +236,36 @@ RawPixels readPfm(const std::string& path, const std::vector<unsigned char>& byt
   return raw;
 }
 
+// Any format OpenImageIO reads, through the image plugin: 8- and 16-bit integers scaled to [0, 1]
+// as readStb scales them, so that both give the same floats for the same samples.
+RawPixels readPlugin(const std::string& path, const ImagePlugin& plugin) {
+  PluginPixels px;
+  const std::string error = plugin.read(path, kMaxPixels, px);
+  if (!error.empty()) throw InputError(path + ": cannot read image: " + error);
+  RawPixels raw{px.width, px.height, px.channels, px.type != PluginPixels::Type::F32, {}};
+  switch (px.type) {
+    case PluginPixels::Type::U8:
+      raw.data.resize(px.u8.size());
+      for (size_t i = 0; i < px.u8.size(); ++i) raw.data[i] = float(px.u8[i]) / 255.0f;
+      break;
+    case PluginPixels::Type::U16:
+      raw.data.resize(px.u16.size());
+      for (size_t i = 0; i < px.u16.size(); ++i) raw.data[i] = float(px.u16[i]) / 65535.0f;
+      break;
+    case PluginPixels::Type::F32:
+      raw.data = std::move(px.f32);
+      break;
+  }
+  return raw;
+}
+
 RawPixels readRaw(const std::string& path) {
   checkExists(path);
   if (Imf::isOpenExrFile(path.c_str())) return readExr(path);
   const std::vector<unsigned char> bytes = fileBytes(path);
-  return isPfm(bytes) ? readPfm(path, bytes) : readStb(path, bytes);
+  if (isPfm(bytes)) return readPfm(path, bytes);
+  if (const ImagePlugin* plugin = imagePlugin()) return readPlugin(path, *plugin);
+  return readStb(path, bytes);
 }
 
 Color pixelRgb(const float* p, int channels) {

@@ -1,6 +1,7 @@
-// Image files: textures in, linear float EXR and 8-bit PNG out. EXR through OpenEXR; PNG, JPEG,
-// BMP, TGA, PSD, GIF, PNM and Radiance HDR through stb_image (in) and stb_image_write (PNG out);
-// PFM (portable float map) read here.
+// Image files: textures in, linear float EXR and 8-bit PNG out. EXR through OpenEXR; PFM (portable
+// float map) read here; every other format through OpenImageIO's image plugin (io/image_plugin.h:
+// PNG, JPEG, TIFF at 8, 16 and 32 bits, TX, HDR, WebP...), or, where the plugin cannot be loaded,
+// through stb_image (PNG, JPEG, BMP, TGA, PSD, GIF, PNM, HDR). PNG out through stb_image_write.
 // Every output is written to a temporary file in the destination folder and renamed into place,
 // so a failed or interrupted run never leaves a half-written image under the requested name.
 #pragma once

@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config
   libembree-dev libhwy-dev libxxhash-dev libopenexr-dev libimath-dev
-  libtinygltf-dev libstb-dev libmeshoptimizer-dev libdraco-dev libwebp-dev libglm-dev libtbb-dev libcli11-dev nlohmann-json3-dev
+  libtinygltf-dev libstb-dev libopenimageio-dev libmeshoptimizer-dev libdraco-dev libwebp-dev libglm-dev libtbb-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libbenchmark-dev libfmt-dev assimp-testmodels
   libopenmpi-dev openmpi-bin clang-14 libclang-rt-14-dev
 )

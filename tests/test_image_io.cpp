@@ -207,10 +207,26 @@ TEST(ImageIo, PfmBothByteOrdersRowsFromTheBottom) {
 
 TEST(ImageIo, HeadersClaimingHugeImagesAreRejectedBeforeAllocating) {
   TempDir dir;
-  // A PNG signature and IHDR chunk of 20000 x 20000 grey, within stb_image's own limit of 2^30 bytes (it does
-  // not check the CRC).
-  std::string png = "\x89PNG\r\n\x1a\n";
-  png += std::string("\0\0\0\x0dIHDR", 8) + std::string("\0\0\x4e\x20\0\0\x4e\x20\x08\0\0\0\0", 13) + "CRC!";
+  // A PNG signature, an IHDR chunk of 20000 x 20000 grey (within stb_image's own limit of 2^30
+  // bytes) and an empty IDAT, with the chunks' CRCs right: libpng, under OpenImageIO, checks them and
+  // reads up to the first IDAT before the size reaches Ember.
+  const auto chunk = [](const std::string& type, const std::string& data) {
+    const std::string body = type + data;
+    uint32_t crc = 0xffffffffu;  // CRC-32 (ISO 3309), as PNG defines it
+    for (unsigned char byte : body) {
+      crc ^= byte;
+      for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xedb88320u & (0u - (crc & 1u)));
+    }
+    crc ^= 0xffffffffu;
+    std::string out;
+    for (int shift = 24; shift >= 0; shift -= 8) out += char((data.size() >> shift) & 0xffu);
+    out += body;
+    for (int shift = 24; shift >= 0; shift -= 8) out += char((crc >> shift) & 0xffu);
+    return out;
+  };
+  const std::string png = "\x89PNG\r\n\x1a\n" +
+                          chunk("IHDR", std::string("\0\0\x4e\x20\0\0\x4e\x20\x08\0\0\0\0", 13)) +
+                          chunk("IDAT", "");
   const std::string big = dir.write("big.png", png);
   const std::string pfmBig = dir.write("big.pfm", "PF\n100000 100000\n-1\n");
   for (const std::string& path : {big, pfmBig}) {
