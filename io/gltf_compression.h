@@ -23,10 +23,15 @@ void decodeCompressedData(tinygltf::Model& model, const std::string& path);
 
 // tinygltf's image loader (TinyGLTF::SetImageLoader) with WebP added: WebP images are decoded with
 // libwebp to 8-bit RGBA, like tinygltf's own loader gives PNGs; KTX2 images are left empty for
-// decodeCompressedData to judge; everything else goes to tinygltf::LoadImageData. Its user data
-// must be the tinygltf::Model being loaded: tinygltf hands a buffer view's image bytes over without
-// checking that the view lies inside its buffer, and the loader does.
+// decodeCompressedData to judge; everything else is kept encoded (Image::as_is) for
+// decodeDeferredImages. Its user data must be the tinygltf::Model being loaded: tinygltf hands a
+// buffer view's image bytes over without checking that the view lies inside its buffer, and the
+// loader does.
 tinygltf::LoadImageDataFunction gltfImageLoader();
+
+// Decodes the images gltfImageLoader kept encoded, in parallel, with tinygltf::LoadImageData as
+// tinygltf's parse would have; the first that fails throws InputError("path: cannot load glTF: ...").
+void decodeDeferredImages(tinygltf::Model& model, const std::string& path);
 
 // tinygltf 2.7 refuses two things these extensions write: a Draco primitive's `indices` accessor
 // without a bufferView ("accessor[N] invalid bufferView"), and a meshopt fallback buffer without a

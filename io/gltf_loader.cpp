@@ -37,6 +37,7 @@ class GltfImporter {
   GltfImport run() {
     load();
     checkVersion(model_.asset.version, model_.asset.minVersion);
+    decodeDeferredImages(model_, path_);  // PNG, JPEG...: all at once, in parallel
     decodeCompressedData(model_, path_);  // meshopt, Draco, WebP: plain data from here on
     checkPrimitiveArrays();
     checkExtensions();

@@ -335,33 +335,6 @@ std::shared_ptr<const Texture> GltfMaterialReader::texture(int index, int texCoo
   const Decoded* img = decode(tex.source, where);
   if (!img) return nullptr;
 
-  const size_t n = size_t(img->width) * size_t(img->height);
-  const int ch = img->channels;
-  std::vector<Color> texels(n);
-  for (size_t i = 0; i < n; ++i) {
-    const float* p = &img->values[i * size_t(ch)];
-    const Color rgb = ch >= 3 ? Color(p[0], p[1], p[2]) : Color(p[0]);
-    switch (channels) {
-      case Channels::SrgbRgb:
-        texels[i] = Color(decodeSrgb(rgb.x), decodeSrgb(rgb.y), decodeSrgb(rgb.z));
-        break;
-      case Channels::LinearRgb:
-        texels[i] = rgb;
-        break;
-      case Channels::Alpha:
-        texels[i] = Color(ch == 4 ? p[3] : ch == 2 ? p[1] : 1.0f);
-        break;
-      case Channels::MetallicRoughness:
-        texels[i] = Color(0.0f, rgb.y, rgb.z);
-        break;
-      case Channels::Red:
-        texels[i] = Color(rgb.x);
-        break;
-      case Channels::Green:
-        texels[i] = Color(ch >= 3 ? rgb.y : rgb.x);
-        break;
-    }
-  }
   TextureWrap wrapS = TextureWrap::Repeat, wrapT = TextureWrap::Repeat;
   TextureFilter filter = TextureFilter::Bilinear;
   if (tex.sampler >= 0) {
@@ -372,7 +345,10 @@ std::shared_ptr<const Texture> GltfMaterialReader::texture(int index, int texCoo
     if (s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST) filter = TextureFilter::Nearest;
   }
   std::shared_ptr<const Texture> out =
-      std::make_shared<ImageTexture>(img->width, img->height, std::move(texels), filter, wrapS, wrapT, scale);
+      img->bytes ? std::make_shared<ImageTexture>(img->width, img->height, byteChannels(*img, channels),
+                                                  filter, wrapS, wrapT, scale)
+                 : std::make_shared<ImageTexture>(img->width, img->height, floatTexels(*img, channels),
+                                                  filter, wrapS, wrapT, scale);
 
   if (const tinygltf::Value* t = extension(extensions, "KHR_texture_transform")) {
     const std::string w = where + ".extensions.KHR_texture_transform";
@@ -403,9 +379,81 @@ std::shared_ptr<const Texture> GltfMaterialReader::texture(int index, int texCoo
   return out;
 }
 
+std::vector<Color> GltfMaterialReader::floatTexels(const Decoded& img, Channels channels) {
+  const size_t n = size_t(img.width) * size_t(img.height);
+  const int ch = img.channels;
+  std::vector<Color> texels(n);
+  for (size_t i = 0; i < n; ++i) {
+    const float* p = &img.values[i * size_t(ch)];
+    const Color rgb = ch >= 3 ? Color(p[0], p[1], p[2]) : Color(p[0]);
+    switch (channels) {
+      case Channels::SrgbRgb:
+        texels[i] = Color(decodeSrgb(rgb.x), decodeSrgb(rgb.y), decodeSrgb(rgb.z));
+        break;
+      case Channels::LinearRgb:
+        texels[i] = rgb;
+        break;
+      case Channels::Alpha:
+        texels[i] = Color(ch == 4 ? p[3] : ch == 2 ? p[1] : 1.0f);
+        break;
+      case Channels::MetallicRoughness:
+        texels[i] = Color(0.0f, rgb.y, rgb.z);
+        break;
+      case Channels::Red:
+        texels[i] = Color(rgb.x);
+        break;
+      case Channels::Green:
+        texels[i] = Color(ch >= 3 ? rgb.y : rgb.x);
+        break;
+    }
+  }
+  return texels;
+}
+
+ImageTexture::ByteChannels GltfMaterialReader::byteChannels(const Decoded& img, Channels channels) {
+  // The same choices as floatTexels, channel by channel: which byte, and the table of its values.
+  const int ch = img.channels;
+  // b / 255.0f, as the float path divides (decode() for 16 bits, image_io's readers for 8).
+  const auto plain = [](int b) { return float(b) / 255.0f; };
+  ImageTexture::ByteChannels in;
+  in.bytes = img.bytes->data();
+  in.stride = ch;
+  const auto constant = [&](int c, float v) {
+    in.source[size_t(c)] = -1;
+    in.tables[size_t(c)].fill(v);
+  };
+  for (int c = 0; c < 3; ++c) {
+    const int rgbSource = ch >= 3 ? c : 0;
+    switch (channels) {
+      case Channels::SrgbRgb:
+      case Channels::LinearRgb:
+        in.source[size_t(c)] = rgbSource;
+        break;
+      case Channels::Alpha:
+        in.source[size_t(c)] = ch == 4 ? 3 : ch == 2 ? 1 : -1;
+        break;
+      case Channels::MetallicRoughness:
+        in.source[size_t(c)] = c == 0 ? -1 : rgbSource;
+        break;
+      case Channels::Red:
+        in.source[size_t(c)] = 0;
+        break;
+      case Channels::Green:
+        in.source[size_t(c)] = ch >= 3 ? 1 : 0;
+        break;
+    }
+    for (int b = 0; b < 256; ++b)
+      in.tables[size_t(c)][size_t(b)] = channels == Channels::SrgbRgb ? decodeSrgb(plain(b)) : plain(b);
+  }
+  if (channels == Channels::Alpha && ch != 4 && ch != 2)
+    for (int c = 0; c < 3; ++c) constant(c, 1.0f);
+  if (channels == Channels::MetallicRoughness) constant(0, 0.0f);
+  return in;
+}
+
 const GltfMaterialReader::Decoded* GltfMaterialReader::decode(int image, const std::string& where) {
   if (const auto it = images_.find(image); it != images_.end())
-    return it->second.values.empty() ? nullptr : &it->second;
+    return it->second.values.empty() && !it->second.bytes ? nullptr : &it->second;
   Decoded& d = images_[image];
   const tinygltf::Image& img = model_.images[size_t(image)];
   if (img.width <= 0 || img.height <= 0 || img.image.empty() || (img.bits != 8 && img.bits != 16) ||
@@ -419,15 +467,15 @@ const GltfMaterialReader::Decoded* GltfMaterialReader::decode(int image, const s
   d.width = img.width;
   d.height = img.height;
   d.channels = img.component;
+  if (img.bits == 8) {
+    d.bytes = &img.image;
+    return &d;
+  }
   d.values.resize(count);
   for (size_t i = 0; i < count; ++i) {
-    if (img.bits == 8) {
-      d.values[i] = img.image[i] / 255.0f;
-    } else {
-      uint16_t v;
-      std::memcpy(&v, &img.image[2 * i], 2);
-      d.values[i] = v / 65535.0f;
-    }
+    uint16_t v;
+    std::memcpy(&v, &img.image[2 * i], 2);
+    d.values[i] = v / 65535.0f;
   }
   return &d;
 }

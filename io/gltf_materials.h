@@ -38,9 +38,10 @@ class GltfMaterialReader {
   const GltfSurface& surface(int index, bool vertexColors = false);
 
  private:
-  struct Decoded {  // an image's channels as floats in [0, 1], not yet colour-decoded
+  struct Decoded {  // an image's channels, not yet colour-decoded
     int width = 0, height = 0, channels = 0;
-    std::vector<float> values;
+    const std::vector<unsigned char>* bytes = nullptr;  // 8-bit images: tinygltf's own pixels
+    std::vector<float> values;                          // 16-bit images: as floats in [0, 1]
   };
   enum class Channels { SrgbRgb, LinearRgb, Alpha, MetallicRoughness, Red, Green };
 
@@ -54,6 +55,10 @@ class GltfMaterialReader {
   std::shared_ptr<const Texture> texture(int index, int texCoord, const tinygltf::ExtensionMap& extensions,
                                          Channels channels, const Color& scale, const std::string& where);
   const Decoded* decode(int image, const std::string& where);
+  // The texels of `channels` (glTF's use of the image's channels) from a 16-bit image's floats, or
+  // the tables and byte positions that give the same values from an 8-bit image's bytes.
+  static std::vector<Color> floatTexels(const Decoded& img, Channels channels);
+  static ImageTexture::ByteChannels byteChannels(const Decoded& img, Channels channels);
   [[noreturn]] void fail(const std::string& where, const std::string& what) const;
   void warn(const std::string& where, const std::string& what) const;
 

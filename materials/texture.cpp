@@ -101,14 +101,7 @@ ImageTexture::ImageTexture(int width, int height, std::vector<Color> texels, Tex
       scale_(scale),
       id_(newHitMemoOwner()) {
   Color sum(0.0f);
-  for (const Color& c : texels_) {
-    const Color scaled = c * scale_;
-    max_ = glm::max(max_, scaled);
-    sum += scaled;
-    const bool positive = scaled.x > 0.0f || scaled.y > 0.0f || scaled.z > 0.0f;
-    const bool negative = scaled.x < 0.0f || scaled.y < 0.0f || scaled.z < 0.0f;
-    mayBeBlack_ = mayBeBlack_ || !positive || negative;
-  }
+  for (const Color& c : texels_) addStatistics(c, sum);
   if (!texels_.empty()) average_ = sum / float(texels_.size());
 
   // First the palettes, which an HDR image overflows within its first few hundred texels; the
@@ -141,6 +134,44 @@ ImageTexture::ImageTexture(int width, int height, std::vector<Color> texels, Tex
       indices_[3 * i + size_t(c)] = uint8_t(channels[c].index(texels_[i][c], palette_[size_t(c)]));
   paletted_ = true;
   std::vector<Color>().swap(texels_);
+}
+
+ImageTexture::ImageTexture(int width, int height, const ByteChannels& in, TextureFilter filter,
+                           TextureWrap wrapS, TextureWrap wrapT, const Color& scale)
+    : width_(width),
+      height_(height),
+      filter_(filter),
+      wrapS_(wrapS),
+      wrapT_(wrapT),
+      scale_(scale),
+      id_(newHitMemoOwner()) {
+  const size_t n = size_t(width) * size_t(height);
+  // Each channel's palette is its table; a texel's index is its byte (0 for a constant channel).
+  for (size_t c = 0; c < 3; ++c) palette_[c] = in.tables[c];
+  indices_.resize(3 * n);
+  Color sum(0.0f);
+  for (size_t i = 0; i < n; ++i) {
+    const uint8_t* texel = in.bytes + i * size_t(in.stride);
+    Color value;
+    for (size_t c = 0; c < 3; ++c) {
+      const uint8_t b = in.source[c] < 0 ? 0 : texel[in.source[c]];
+      indices_[3 * i + c] = b;
+      value[int(c)] = palette_[c][b];
+    }
+    addStatistics(value, sum);
+  }
+  if (n > 0) average_ = sum / float(n);
+  paletted_ = true;
+  // As the float constructor does: one byte per texel where at most 256 colours occur.
+  ColorPalette colors;
+  std::vector<Color> palette;
+  for (size_t i = 0; i < n; ++i)
+    if (colors.index(texel(int(i % size_t(width)), int(i / size_t(width))), palette) < 0) return;
+  std::vector<uint8_t> single(n);
+  for (size_t i = 0; i < n; ++i)
+    single[i] = uint8_t(colors.index(texel(int(i % size_t(width)), int(i / size_t(width))), palette));
+  indices_ = std::move(single);
+  colorPalette_ = std::move(palette);
 }
 
 static int wrapIndex(int i, int n, TextureWrap wrap) {

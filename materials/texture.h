@@ -62,6 +62,18 @@ class ImageTexture final : public Texture {
   // wrapS applies along u (columns), wrapT along v (rows), as glTF samplers define them.
   ImageTexture(int width, int height, std::vector<Color> texels, TextureFilter filter, TextureWrap wrapS,
                TextureWrap wrapT, const Color& scale = Color(1.0f));
+  // An 8-bit image read through a table per channel, without a float copy of it: channel c of
+  // texel i is tables[c][bytes[i * stride + source[c]]], or tables[c][0] where source[c] < 0. The
+  // texture then equals the one built from those floats, value for value, in a quarter of the
+  // memory traffic (most of a textured glTF file's load time went to the float copies).
+  struct ByteChannels {
+    const uint8_t* bytes = nullptr;
+    int stride = 0;
+    std::array<int, 3> source{};
+    std::array<std::array<float, 256>, 3> tables{};
+  };
+  ImageTexture(int width, int height, const ByteChannels& in, TextureFilter filter, TextureWrap wrapS,
+               TextureWrap wrapT, const Color& scale = Color(1.0f));
   // Not copied or moved: evalAt's memo keys the texture's values by its id (materials/hit_memo.h).
   ImageTexture(const ImageTexture&) = delete;
   ImageTexture& operator=(const ImageTexture&) = delete;
@@ -80,6 +92,15 @@ class ImageTexture final : public Texture {
  private:
   Color texel(int x, int y) const;    // (x, y) wrapped into the image first
   Color texelAt(int x, int y) const;  // (x, y) inside the image
+  // max_, mayBeBlack_ and the sum for average_, texel by texel (inline: it runs per texel at load).
+  void addStatistics(const Color& texel, Color& sum) {
+    const Color scaled = texel * scale_;
+    max_ = glm::max(max_, scaled);
+    sum += scaled;
+    const bool positive = scaled.x > 0.0f || scaled.y > 0.0f || scaled.z > 0.0f;
+    const bool negative = scaled.x < 0.0f || scaled.y < 0.0f || scaled.z < 0.0f;
+    mayBeBlack_ = mayBeBlack_ || !positive || negative;
+  }
 
   int width_, height_;
   // Texels of at most 256 distinct values per channel (every 8-bit image, whatever its encoding)
