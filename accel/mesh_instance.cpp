@@ -69,6 +69,17 @@ TriangleMesh::Surface MeshInstance::surfaceAt(uint32_t prim, float b1, float b2)
   return s;
 }
 
+float MeshInstance::uvDensity(uint32_t prim) const {
+  // The object-space density, over the placement's scaling of this triangle's area.
+  const glm::uvec3& idx = mesh_->indices[prim];
+  const Vec3 p0 = toWorldPoint(mesh_->positions[idx.x]);
+  const float world = glm::length(
+      glm::cross(toWorldPoint(mesh_->positions[idx.y]) - p0, toWorldPoint(mesh_->positions[idx.z]) - p0));
+  const Vec3& q0 = mesh_->positions[idx.x];
+  const float local = glm::length(glm::cross(mesh_->positions[idx.y] - q0, mesh_->positions[idx.z] - q0));
+  return world > 0.0f ? mesh_->uvDensity(prim) * std::sqrt(local / world) : 0.0f;
+}
+
 Bounds MeshInstance::bounds() const {
   const Bounds local = mesh_->bounds();
   Bounds out;

@@ -37,6 +37,7 @@ class MeshInstance final : public VertexAttributes {
   glm::vec4 colorAt(uint32_t prim, Vec2 b) const override { return mesh_->colorAt(prim, b); }
   Vec3 normalAt(uint32_t prim, Vec2 b) const override { return surfaceAt(prim, b.x, b.y).ns; }
   glm::vec4 tangentAt(uint32_t prim, Vec2 b) const override { return surfaceAt(prim, b.x, b.y).tangent; }
+  float uvDensity(uint32_t prim) const override;
 
  private:
   Vec3 toWorldPoint(const Vec3& p) const { return Vec3(toWorld_ * glm::vec4(p, 1.0f)); }

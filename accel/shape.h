@@ -78,6 +78,13 @@ class Shape {
   virtual SurfacePoint projectToSurface(const Vec3& p, const LocalHit& hit) const = 0;
 
   virtual float area() const = 0;
+  // Texture coordinates per unit of length, on average over the surface (a filtered texture's
+  // footprint scale, Scene::surfaceHit): the UV square spread over the area, unless the shape
+  // carries its own texture coordinates.
+  virtual float uvDensity() const {
+    const float a = area();
+    return a > 0.0f && std::isfinite(a) ? 1.0f / std::sqrt(a) : 0.0f;
+  }
 
   // Whether the whole shape lies in one plane. A ray leaving such a shape (its origin pushed off
   // the plane to the side it travels to, core/ray_spawn.h) never meets it again, and neither does a

@@ -368,3 +368,30 @@ ShapeSample Quad::sampleArea(Vec2 u) const {
 }
 
 }  // namespace ember
+
+namespace ember {
+
+namespace {
+
+// sqrt(UV area / area) of a triangle: its texture coordinates per unit of length.
+float uvDensityOf(Vec2 a, Vec2 b, Vec2 c, float area) {
+  const Vec2 du = b - a, dv = c - a;
+  const float uvArea = 0.5f * std::abs(du.x * dv.y - du.y * dv.x);
+  return area > 0.0f && std::isfinite(uvArea) ? std::sqrt(uvArea / area) : 0.0f;
+}
+
+}  // namespace
+
+float Triangle::uvDensity() const {
+  return uvDensityOf(uv_[0], uv_[1], uv_[2], area_);
+}
+
+float Quad::uvDensity() const {
+  // The two halves' UV areas over their areas together.
+  const float d0 = uvDensityOf(uv_[0], uv_[1], uv_[2], area0_),
+              d1 = uvDensityOf(uv_[0], uv_[2], uv_[3], area1_);
+  const float area = area0_ + area1_;
+  return area > 0.0f ? std::sqrt((d0 * d0 * area0_ + d1 * d1 * area1_) / area) : 0.0f;
+}
+
+}  // namespace ember

@@ -29,6 +29,7 @@ class Triangle final : public Shape {
   void intersectLanes(const RayLanes& rays, LaneHits& out) const override;
   SurfacePoint projectToSurface(const Vec3& p, const LocalHit&) const override { return plane_.project(p); }
   float area() const override { return area_; }
+  float uvDensity() const override;
   bool flat() const override { return true; }
   ShapeSample sampleArea(Vec2 u) const override;
   // Seen from close by, uniform in the solid angle it subtends (accel/spherical_triangle.h).
@@ -58,6 +59,7 @@ class Quad final : public Shape {
   // vertices need only be coplanar to 1e-4 of its size.
   SurfacePoint projectToSurface(const Vec3& p, const LocalHit& hit) const override;
   float area() const override { return area0_ + area1_; }
+  float uvDensity() const override;
   // Only when both halves lie in the same plane: a quad folded within the loader's tolerance could
   // be met again by a grazing ray leaving its other half.
   bool flat() const override { return samePlanes_; }

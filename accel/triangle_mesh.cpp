@@ -32,6 +32,16 @@ glm::vec4 TriangleMesh::interpolatedTangent(uint32_t prim, float b1, float b2) c
   return (1.0f - b1 - b2) * tangents[idx.x] + b1 * tangents[idx.y] + b2 * tangents[idx.z];
 }
 
+float TriangleMesh::uvDensity(uint32_t prim) const {
+  if (uvs.empty()) return 0.0f;
+  const glm::uvec3& idx = indices[prim];
+  const Vec2 du = uvs[idx.y] - uvs[idx.x], dv = uvs[idx.z] - uvs[idx.x];
+  const float uvArea = std::abs(du.x * dv.y - du.y * dv.x);
+  const float area =
+      glm::length(glm::cross(positions[idx.y] - positions[idx.x], positions[idx.z] - positions[idx.x]));
+  return area > 0.0f && std::isfinite(uvArea) ? std::sqrt(uvArea / area) : 0.0f;
+}
+
 Vec2 TriangleMesh::uvAt(uint32_t prim, float b1, float b2) const {
   if (uvs.empty()) return Vec2(b1, b2);
   const glm::uvec3& idx = indices[prim];

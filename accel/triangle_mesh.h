@@ -63,6 +63,7 @@ struct TriangleMesh final : VertexAttributes {
   glm::vec4 colorAt(uint32_t prim, Vec2 b) const override;
   Vec3 normalAt(uint32_t prim, Vec2 b) const override { return surfaceAt(prim, b.x, b.y).ns; }
   glm::vec4 tangentAt(uint32_t prim, Vec2 b) const override { return surfaceAt(prim, b.x, b.y).tangent; }
+  float uvDensity(uint32_t prim) const override;
   // The point at barycentrics (b1, b2) of triangle `prim`, interpolated from its vertices, with the
   // rounding-error bound of points computed from them (core/ray_spawn.h).
   Vec3 pointAt(uint32_t prim, float b1, float b2) const;

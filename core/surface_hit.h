@@ -33,6 +33,9 @@ struct SurfaceHit {
   const VertexAttributes* attributes = nullptr;
   uint32_t prim = 0;
   Vec2 bary{0.0f};  // barycentrics (b1, b2) within triangle `prim`
+  // The width of one pixel's footprint here, in texture coordinates (set 0), for filtered textures;
+  // 0 where the scene has none (Scene::surfaceHit, Camera::footprintAt).
+  float uvFootprint = 0.0f;
 
   // Texture coordinates of set `set`: uv for set 0, and on shapes without further sets.
   Vec2 texCoord(int set) const {

@@ -21,6 +21,10 @@ class VertexAttributes {
   // tangent with its bitangent sign in w (zero without tangents), before any normal map.
   virtual Vec3 normalAt(uint32_t prim, Vec2 b) const = 0;
   virtual glm::vec4 tangentAt(uint32_t prim, Vec2 b) const = 0;
+  // Texture coordinates (set 0) per unit of length on triangle `prim`: sqrt(UV area / area), the
+  // scale a filtered texture turns a footprint's width into UV units with (Scene::surfaceHit); 0
+  // (no filtering) where unknown.
+  virtual float uvDensity(uint32_t) const { return 0.0f; }
 };
 
 }  // namespace ember

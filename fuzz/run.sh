@@ -44,6 +44,7 @@ status=0
 for target in scene_json gltf checkpoint image; do
   echo "fuzz_$target: ${seconds}s from $(ls "$corpus/$target" | wc -l) seeds"
   if ! ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+      LSAN_OPTIONS=suppressions="$PWD/scripts/lsan-suppressions.txt" \
       "build-fuzz/fuzz/fuzz_$target" "$corpus/$target" -max_total_time="$seconds" -timeout=20 \
       -rss_limit_mb=4096 -print_final_stats=1 -artifact_prefix="build-fuzz/crash-$target-" \
       > "build-fuzz/fuzz_$target.log" 2>&1; then

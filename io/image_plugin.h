@@ -31,19 +31,26 @@ struct PluginPixels {
 
 class ImagePlugin {
  public:
-  static constexpr int kAbiVersion = 1;
+  static constexpr int kAbiVersion = 2;
   virtual ~ImagePlugin() = default;
   // The largest width x height read (the caller's limit), checked before pixels are allocated.
   // Returns "" on success, else the reason, without the file's name.
   virtual std::string read(const std::string& path, int64_t maxPixels, PluginPixels& out) const = 0;
-  // The same from bytes in memory (an image embedded in a glTF file); `name` only for messages.
-  virtual std::string readMemory(const void* data, size_t size, const std::string& name, int64_t maxPixels,
-                                 PluginPixels& out) const = 0;
   // Writes `pixels` in the format the path's extension names (U8, U16 or F32 as stored); ".tx"
   // writes a tiled, MIP-mapped texture (OpenImageIO's maketx). Returns "" or the reason.
   virtual std::string write(const std::string& path, const PluginPixels& pixels) const = 0;
   // "OpenImageIO 2.4.7" and the formats it reads.
   virtual std::string describe() const = 0;
+
+  // Filtered textures, through OpenImageIO's TextureSystem. addTexture serves an image Ember has
+  // decoded (linear RGB floats, rows from the top; they must outlive the process's lookups) to the
+  // texture system from memory, which makes its MIP levels on first use. nullptr on failure.
+  virtual const void* addTexture(const float* rgb, int width, int height) const = 0;
+  enum class Wrap { Clamp, Repeat, Mirror };
+  // The texture at (s, t) (s along the width, t down the rows, [0, 1] over the image), filtered
+  // trilinearly over the footprint the derivatives span. False on a read error.
+  virtual bool lookup(const void* texture, Wrap wrapS, Wrap wrapT, float s, float t, float dsdx, float dtdx,
+                      float dsdy, float dtdy, float rgb[3]) const = 0;
 };
 
 // The plugin, loaded on the first call (thread-safe); nullptr when it cannot be: then

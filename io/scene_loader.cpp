@@ -1,5 +1,8 @@
 #include "io/scene_loader.h"
 
+#include "io/filtered_texture.h"
+#include "io/image_plugin.h"
+
 #include "accel/box.h"
 #include "accel/cone.h"
 #include "accel/cylinder.h"
@@ -116,13 +119,19 @@ class JsonSceneLoader {
     scene_.background = n.color("background", Color(0.0f));
   }
 
-  // The optional "filter" key of a texture or environment map.
-  static TextureFilter readFilter(const JsonNode& n) {
+  // The optional "filter" key of a texture or environment map; `trilinear` (textures only) sets
+  // *trilinear and reads as bilinear.
+  static TextureFilter readFilter(const JsonNode& n, bool* trilinear = nullptr) {
     const auto f = n.find("filter");
     if (!f) return TextureFilter::Bilinear;
     const std::string v = f->string();
     if (v == "nearest") return TextureFilter::Nearest;
-    if (v != "bilinear") f->fail("unknown filter '" + v + "'; valid: nearest, bilinear");
+    if (v == "trilinear" && trilinear) {
+      *trilinear = true;
+      return TextureFilter::Bilinear;
+    }
+    if (v != "bilinear")
+      f->fail("unknown filter '" + v + "'; valid: nearest, bilinear" + (trilinear ? ", trilinear" : ""));
     return TextureFilter::Bilinear;
   }
 
@@ -155,7 +164,12 @@ class JsonSceneLoader {
       else if (v != "auto")
         e->fail("unknown encoding '" + v + "'; valid: auto, srgb, linear");
     }
-    const TextureFilter filter = readFilter(n);
+    bool trilinear = false;
+    const TextureFilter filter = readFilter(n, &trilinear);
+    const ImagePlugin* plugin = trilinear ? imagePlugin() : nullptr;
+    if (trilinear && !plugin)
+      n.at("filter").fail("filter 'trilinear' needs the OpenImageIO plugin, which could not be loaded: " +
+                          imagePluginError());
     TextureWrap wrap = TextureWrap::Repeat;
     if (auto w = n.find("wrap")) {
       const std::string v = w->string();
@@ -173,6 +187,15 @@ class JsonSceneLoader {
       scene_.sourceFiles.push_back(texPath.string());
     } catch (const InputError& e) {
       file.fail(e.what());
+    }
+    if (trilinear) {
+      scene_.filteredTextures = true;
+      try {
+        return std::make_shared<FilteredImageTexture>(*plugin, texPath.string(), img.width, img.height,
+                                                      img.texels, wrap, n.color("scale", Color(1.0f)));
+      } catch (const InputError& e) {
+        file.fail(e.what());
+      }
     }
     return std::make_shared<ImageTexture>(img.width, img.height, std::move(img.texels), filter, wrap,
                                           n.color("scale", Color(1.0f)));

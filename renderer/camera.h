@@ -61,6 +61,20 @@ class Camera {
     return true;
   }
 
+  // The width of one pixel's footprint on a surface at p with unit normal n, as the camera sees
+  // it: the pixel's spread at p's distance, widened by 1 / sqrt|cos| of the viewing angle (the
+  // geometric mean of the footprint ellipse's axes). pbrt-v4's camera approximation of ray
+  // differentials at every vertex (Camera::Approximate_dp_dxy, section 10.1.1), in isotropic form;
+  // it depends on the image's size and never on the sample count, so that renders split over runs
+  // merge exactly.
+  float footprintAt(const Vec3& p, const Vec3& n) const {
+    const Vec3 d = orthographic_ ? forward_ : p - origin_;
+    const float distance = orthographic_ ? 1.0f : glm::length(d);
+    const float cosine = std::abs(glm::dot(d, n)) / (orthographic_ ? 1.0f : distance);
+    const float width = 2.0f * scale_ * invHeight_ * distance;
+    return width / std::sqrt(std::max(cosine, 1e-3f));
+  }
+
  private:
   CameraParams params_;
   Vec3 origin_, forward_, right_, up_;

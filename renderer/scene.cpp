@@ -81,6 +81,7 @@ void Scene::build() {
     GeometryRecord rec{entry.shape.get(), nullptr,        entry.material,
                        nullptr,           entry.emission, entry.twoSidedEmission};
     rec.readsUv = readsUv;
+    rec.uvDensity = entry.shape->uvDensity();
     rec.deltaLobes = entry.material && entry.material->hasDeltaLobes();
     const bool flat = entry.shape->flat();
     const int convex = entry.shape->convexSide();
@@ -228,6 +229,11 @@ void Scene::surfaceHit(const Ray& ray, const RawHit& raw, SurfaceHit& hit) const
       ns = rec.maps->perturb(s.ns, s.tangent, hit.texCoord(rec.maps->normalMap->texCoordSet()));
     // Keep the shading normal in the geometric normal's hemisphere.
     hit.ns = glm::dot(ns, s.ng) < 0.0f ? -ns : ns;
+  }
+  hit.uvFootprint = 0.0f;
+  if (filteredTextures) {
+    const float density = rec.shape ? rec.uvDensity : hit.attributes->uvDensity(raw.primID);
+    hit.uvFootprint = camera_.footprintAt(hit.p, hit.ng) * density;
   }
   hit.material = rec.material;
   hit.light =

@@ -73,6 +73,8 @@ class Scene {
   // An equirectangular environment map (linear radiance), used instead of `background` when set.
   std::shared_ptr<const ImageTexture> environmentMap;
   float environmentRotateYDeg = 0.0f;
+  // Some texture is filtered over the footprint of each hit: surfaceHit then works it out.
+  bool filteredTextures = false;
   std::vector<std::unique_ptr<Material>> materials;
   std::vector<std::string> materialNames;  // parallel to materials
   // The KHR_materials_variants names of the glTF files loaded (`ember info` lists them).
@@ -138,6 +140,7 @@ class Scene {
     const MeshInstance* instance = nullptr;  // where the mesh is placed as an instance
     int64_t firstTriangleLight = -1;  // emissive meshes: index of primitive 0's light in triangleLights_
     bool readsUv = true;              // whether the material reads the hit's texture coordinates
+    float uvDensity = 0.0f;           // shapes: Shape::uvDensity
     bool deltaLobes = false;          // the material's Material::hasDeltaLobes, asked once
     uint32_t maskFront = kAllRayMask, maskBack = kAllRayMask;  // SurfaceHit's of its hits
   };

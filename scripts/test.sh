@@ -17,7 +17,7 @@ if [ "${EMBER_SKIP_SANITIZERS:-0}" != 1 ]; then
   CXX=clang++-14 cmake -S . -B build-sanitize -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DEMBER_SANITIZE=ON >/dev/null
   cmake --build build-sanitize -j "$jobs"
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-    ctest --test-dir build-sanitize --output-on-failure -j "$jobs" -L unit
+    LSAN_OPTIONS=suppressions="$PWD/scripts/lsan-suppressions.txt" ctest --test-dir build-sanitize --output-on-failure -j "$jobs" -L unit
 fi
 
 if [ "${EMBER_SKIP_FUZZ:-0}" != 1 ]; then

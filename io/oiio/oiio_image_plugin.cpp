@@ -1,15 +1,21 @@
-// The image plugin (io/image_plugin.h) on OpenImageIO: every format OpenImageIO reads (PNG, JPEG,
-// TIFF at 8, 16 and 32 bits, TX, EXR, HDR, WebP, DDS, JPEG 2000...), the top level of its first
-// subimage, in the file's own integer type where it has one (so that the caller decodes 8- and
-// 16-bit values exactly as its other readers do) and as floats otherwise.
+// The image plugin (io/image_plugin.h) on OpenImageIO: its still-image formats (PNG, JPEG, TIFF at
+// 8, 16 and 32 bits, TX, EXR, HDR, WebP, DDS, JPEG 2000, PSD, GIF, BMP, PNM, SGI, ICO, Targa), the
+// top level of the first subimage, in the file's own integer type where it has one (so that the
+// caller decodes 8- and 16-bit values exactly as its other readers do) and as floats otherwise;
+// and filtered lookups through its TextureSystem.
 #include "io/image_plugin.h"
 
-#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
+#include <OpenImageIO/imagecache.h>
 #include <OpenImageIO/imageio.h>
+#include <OpenImageIO/texture.h>
 
+#include <atomic>
+#include <cstring>
 #include <memory>
+#include <mutex>
+#include <unordered_map>
 
 namespace ember {
 namespace {
@@ -60,6 +66,13 @@ std::string readOpen(oiio::ImageInput& in, int64_t maxPixels, PluginPixels& out)
   return "";
 }
 
+// The formats images are read in: OpenImageIO's still-image readers. Its readers of video (ffmpeg),
+// camera raw, DICOM, FITS, HEIF and OpenVDB are left out: no texture comes in them, and a file that
+// is not an image should not reach decoders of that size. Targa, whose header has no signature,
+// is tried last.
+constexpr const char* kImageFormats[] = {"png", "jpeg", "tiff", "openexr", "hdr", "webp", "dds",  "jpeg2000",
+                                         "psd", "gif",  "bmp",  "pnm",     "sgi", "ico",  "targa"};
+
 // Colours as stored: OpenImageIO would otherwise premultiply PNG, TGA and TIFF colours by an
 // unassociated alpha (darkening a glTF base colour wherever its alpha is below 1), which the
 // built-in readers, and glTF, do not.
@@ -72,6 +85,74 @@ const oiio::ImageSpec& readConfig() {
   return config;
 }
 
+// Images Ember decoded, by the names they are registered under with the texture system's cache.
+struct MemoryImage {
+  const float* rgb = nullptr;
+  int width = 0, height = 0;
+};
+std::mutex registryMutex;
+std::unordered_map<std::string, MemoryImage> registry;
+
+// An ImageInput that reads a registered image from memory: the texture system's cache opens it
+// by name (ImageCache::add_file with this creator) and reads its scanlines when it needs them.
+class MemoryInput final : public oiio::ImageInput {
+ public:
+  const char* format_name() const override { return "ember_memory"; }
+  bool open(const std::string& name, oiio::ImageSpec& spec) override {
+    {
+      std::lock_guard<std::mutex> lock(registryMutex);
+      const auto it = registry.find(name);
+      if (it == registry.end()) return false;
+      image_ = it->second;
+    }
+    m_spec = oiio::ImageSpec(image_.width, image_.height, 3, oiio::TypeDesc::FLOAT);
+    spec = m_spec;
+    return true;
+  }
+  bool close() override { return true; }
+  bool read_native_scanline(int subimage, int miplevel, int y, int, void* data) override {
+    if (subimage != 0 || miplevel != 0 || y < 0 || y >= image_.height) return false;
+    const size_t row = size_t(image_.width) * 3;
+    std::memcpy(data, image_.rgb + size_t(y) * row, row * sizeof(float));
+    return true;
+  }
+
+ private:
+  MemoryImage image_;
+};
+
+oiio::ImageInput* createMemoryInput() {
+  return new MemoryInput;
+}
+
+// One texture system for the process, destroyed at exit (so that leak checkers see it freed).
+oiio::TextureSystem& textureSystem() {
+  struct Owner {
+    oiio::TextureSystem* ts;
+    Owner() : ts(oiio::TextureSystem::create(/*shared=*/false)) {
+      // MIP levels made on first use for images that have none, kept in 64x64 tiles.
+      ts->attribute("automip", 1);
+      ts->attribute("autotile", 64);
+      ts->attribute("max_memory_MB", 1024.0f);
+    }
+    ~Owner() { oiio::TextureSystem::destroy(ts); }
+  };
+  static Owner owner;
+  return *owner.ts;
+}
+
+oiio::TextureOpt::Wrap oiioWrap(ImagePlugin::Wrap w) {
+  switch (w) {
+    case ImagePlugin::Wrap::Clamp:
+      return oiio::TextureOpt::WrapClamp;
+    case ImagePlugin::Wrap::Mirror:
+      return oiio::TextureOpt::WrapMirror;
+    case ImagePlugin::Wrap::Repeat:
+      break;
+  }
+  return oiio::TextureOpt::WrapPeriodic;
+}
+
 class OiioImagePlugin final : public ImagePlugin {
  public:
   OiioImagePlugin() {
@@ -80,19 +161,18 @@ class OiioImagePlugin final : public ImagePlugin {
   }
 
   std::string read(const std::string& path, int64_t maxPixels, PluginPixels& out) const override {
-    auto in = oiio::ImageInput::open(path, &readConfig());
-    if (!in) return lastError("no reader for this file");
-    return readOpen(*in, maxPixels, out);
-  }
-
-  std::string readMemory(const void* data, size_t size, const std::string& name, int64_t maxPixels,
-                         PluginPixels& out) const override {
-    oiio::Filesystem::IOMemReader proxy(data, size);
-    // The name's extension picks the first reader tried; OpenImageIO then tries every reader
-    // that takes an in-memory proxy.
-    auto in = oiio::ImageInput::open(name, &readConfig(), &proxy);
-    if (!in) return lastError("no reader for this image");
-    return readOpen(*in, maxPixels, out);
+    // The reader is the first of the image formats below that recognises the contents.
+    for (const char* format : kImageFormats) {
+      auto in = oiio::ImageInput::create(format);
+      if (!in || !in->valid_file(path)) continue;
+      oiio::ImageSpec spec;
+      if (!in->open(path, spec, readConfig())) {
+        std::string e = in->geterror();
+        return e.empty() ? lastError("cannot open it as " + std::string(format)) : e;
+      }
+      return readOpen(*in, maxPixels, out);
+    }
+    return "not an image in a format Ember reads through OpenImageIO";
   }
 
   std::string write(const std::string& path, const PluginPixels& px) const override {
@@ -126,9 +206,39 @@ class OiioImagePlugin final : public ImagePlugin {
     return "";
   }
 
+  const void* addTexture(const float* rgb, int width, int height) const override {
+    static std::atomic<uint64_t> counter{0};
+    const std::string name = "ember-memory-" + std::to_string(counter++);
+    {
+      std::lock_guard<std::mutex> lock(registryMutex);
+      registry[name] = MemoryImage{rgb, width, height};
+    }
+    oiio::TextureSystem& ts = textureSystem();
+    const oiio::ustring key(name);
+    if (!ts.imagecache()->add_file(key, &createMemoryInput)) return nullptr;
+    return ts.get_texture_handle(key);
+  }
+
+  bool lookup(const void* texture, Wrap wrapS, Wrap wrapT, float s, float t, float dsdx, float dtdx,
+              float dsdy, float dtdy, float rgb[3]) const override {
+    oiio::TextureSystem& ts = textureSystem();
+    thread_local oiio::TextureSystem::Perthread* thread = ts.get_perthread_info();
+    oiio::TextureOpt opt;
+    opt.swrap = oiioWrap(wrapS);
+    opt.twrap = oiioWrap(wrapT);
+    opt.mipmode = oiio::TextureOpt::MipModeTrilinear;
+    opt.interpmode = oiio::TextureOpt::InterpBilinear;
+    auto* handle = static_cast<oiio::TextureSystem::TextureHandle*>(const_cast<void*>(texture));
+    return ts.texture(handle, thread, opt, s, t, dsdx, dtdx, dsdy, dtdy, 3, rgb);
+  }
+
   std::string describe() const override {
     std::string formats;
-    oiio::getattribute("input_format_list", formats);
+    for (const char* format : kImageFormats)
+      if (oiio::ImageInput::create(format)) {
+        if (!formats.empty()) formats += ',';
+        formats += format;
+      }
     return "OpenImageIO " + std::string(OIIO_VERSION_STRING) + " (reads " + formats + ")";
   }
 };

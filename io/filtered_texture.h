@@ -1,0 +1,46 @@
+// An image texture filtered over each hit's footprint ("filter": "trilinear" in a scene file):
+// OpenImageIO's TextureSystem (through the image plugin, io/image_plugin.h) looks it up between
+// the two MIP levels whose texels are nearest the footprint's width, bilinearly within each. The
+// footprint is the hit's SurfaceHit::uvFootprint (Camera::footprintAt), so the image is no longer
+// the pixel integral of the unfiltered texture: filtering trades that bias for less aliasing at
+// low sample counts, which is why it is opt-in (docs/scene-format.md).
+#pragma once
+
+#include "io/image_plugin.h"
+#include "materials/texture.h"
+
+#include <vector>
+
+namespace ember {
+
+class FilteredImageTexture final : public Texture {
+ public:
+  // `texels`: linear, rows from the top. Throws InputError(`name`: ...) if the texture system
+  // cannot take the image.
+  FilteredImageTexture(const ImagePlugin& plugin, const std::string& name, int width, int height,
+                       const std::vector<Color>& texels, TextureWrap wrap, const Color& scale);
+  FilteredImageTexture(const FilteredImageTexture&) = delete;
+  FilteredImageTexture& operator=(const FilteredImageTexture&) = delete;
+
+  // Without a footprint: the finest level, bilinearly (what a lookup from a light sample gets).
+  Color eval(Vec2 uv) const override { return lookup(uv, 0.0f); }
+  Color evalAt(const SurfaceHit& hit) const override;
+  Color evalFresh(const SurfaceHit& hit) const override { return lookup(hit.uv, hit.uvFootprint); }
+  Color maxValue() const override { return max_; }
+  Color average() const override { return average_; }
+  bool mayBeBlack() const override { return mayBeBlack_; }
+
+ private:
+  Color lookup(Vec2 uv, float width) const;
+
+  const ImagePlugin& plugin_;
+  std::vector<float> rgb_;  // what the texture system reads, from memory
+  const void* handle_;
+  ImagePlugin::Wrap wrap_;
+  Color scale_;
+  Color max_{0.0f}, average_{0.0f};
+  bool mayBeBlack_ = false;
+  uint64_t id_;  // evalAt's memo key (materials/hit_memo.h)
+};
+
+}  // namespace ember
