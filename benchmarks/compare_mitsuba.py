@@ -108,12 +108,16 @@ def main():
         spec = os.path.join(ROOT, "tests", "data", name, "scene.json")
         for spp in args.spp:
             row = {"scene": name, "spp": spp}
+            # Mitsuba's path tracer cannot find a point light's caustics, which Ember light-traces by
+            # default: against its references such scenes render path-traced in every column.
+            with open(os.path.join(ROOT, "scenes", name + ".json")) as f:
+                point_lights = any(l.get("type") in ("point", "spot") for l in json.load(f).get("lights", []))
             for kernel, sampler, caustics in itertools.product(args.kernels, args.samplers, args.caustics):
                 errs, times, walls = [], [], []
                 for s in range(args.seeds):
                     img, dt, wall = render_ember(args.ember, os.path.join(ROOT, "scenes", name + ".json"), spp,
                                                  100 + s, args.threads, os.path.join(tmp, "e.exr"), sampler, kernel,
-                                                 caustics)
+                                                 "path" if point_lights else caustics)
                     errs.append(relmse(img, ref))
                     times.append(dt)
                     walls.append(wall)

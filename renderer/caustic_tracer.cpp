@@ -71,25 +71,25 @@ Color CausticSplats::at(int index, int x, int y) const {
   return c;
 }
 
-CausticTracer::CausticTracer(std::vector<CausticCaster> casters, std::vector<const AreaLight*> lights,
+CausticTracer::CausticTracer(std::vector<CausticCaster> casters, std::vector<const Light*> lights,
                              bool perspective, float pathsPerPixel)
     : casters_(std::move(casters)), lights_(std::move(lights)), pathsPerPixel_(pathsPerPixel) {
   whyDisabled_ = casters_.empty()                ? "no mirror or glass"
                  : casters_.size() > kMaxCasters ? "more specular objects than it aims at (64)"
-                 : lights_.empty()               ? "no area light to trace from"
+                 : lights_.empty()               ? "no light to trace from"
                  : !perspective                  ? "not a perspective camera"
                                                  : "";
   enabled_ = *whyDisabled_ == '\0';
   if (!enabled_) return;
   std::vector<double> weights;
   double total = 0.0;
-  for (const AreaLight* light : lights_) {
+  for (const Light* light : lights_) {
     weights.push_back(std::max(0.0, double(maxComponent(light->power(0.0f)))));
     total += weights.back();
   }
   if (!(total > 0.0) || !std::isfinite(total)) {
     enabled_ = false;
-    whyDisabled_ = "no area light emits";
+    whyDisabled_ = "no light emits";
     return;
   }
   lightChoice_ = AliasTable(weights);
@@ -190,22 +190,26 @@ bool CausticTracer::startWith(const EmissionNumbers& u, int index, float pathsPe
   // Segments counted as the path tracer counts them, the camera's included: a connection from
   // the vertex at the end of light segment n makes a path of n + 1.
   if (!reachesCaustics(maxDepth)) return false;
-  // A light by power, a point uniformly on it, a direction towards a caster.
+  // A light by power, a point on it (uniform by area, or a point light's position), a direction
+  // towards a caster.
   const size_t li = lightChoice_.sample(u.light);
-  const AreaLight& light = *lights_[li];
-  const ShapeSample y = light.shape()->sampleArea(u.area);
+  const Light& light = *lights_[li];
+  EmissionPoint y;
+  if (!light.sampleEmission(u.area, y)) return false;
   const Vec3 dir = sampleDirection(y.p, u.pick, u.direction);
-  const float cosLight = glm::dot(dir, y.n);
-  if (!light.twoSided() && !(cosLight > 0.0f)) return false;
+  const Color emitted = light.emittedToward(y, dir);
+  if (isBlack(emitted)) return false;
   const float pdfDir = directionPdf(y.p, dir);
   if (!(pdfDir > 0.0f)) return false;
-  // Le |cos| / (p_light p_area p_dir), p_area = 1 / area.
-  path.beta = light.radiance() * (std::abs(cosLight) * light.shape()->area() / (lightPmf_[li] * pdfDir));
+  // Le |cos| / (p_light p_area p_dir) on a surface, I / (p_light p_dir) from a point.
+  path.beta = emitted / (lightPmf_[li] * y.pdfArea * pdfDir);
   path.scattering = Color(1.0f);
   path.segments = 1;
   path.index = index;
   path.pathsPerPixel = pathsPerPixel;
-  path.ray = Ray{offsetAlongNormal(y.p, y.n, light.pointError(), dir), dir};
+  path.range = y.range;
+  // A surface's point pushed off it to the side the ray leaves by; a point light's is exact.
+  path.ray = Ray{glm::dot(y.n, y.n) > 0.0f ? offsetAlongNormal(y.p, y.n, y.pError, dir) : y.p, dir};
   path.rayMask = light.shadowMask;  // leaving the light, it cannot meet a flat one again
   return true;
 }
@@ -233,6 +237,9 @@ bool CausticTracer::connect(const Scene& scene, int maxDepth, PathState& path, c
   if (glm::dot(path.ray.dir, hit.ng) > 0.0f) path.beta *= m.interiorTransmittance(hit.t);
   const Vec3 wo = -path.ray.dir;  // towards the light side
   const bool first = path.segments == 1;
+  // A ranged punctual light's window over the first segment's length, as next-event estimation
+  // applies it over the distance to the light.
+  if (first && path.range > 0.0f) path.beta *= rangeWindow(hit.t, path.range);
   if (first && !m.hasDeltaLobes()) return false;  // the path tracer's: no Dirac vertex next to the light
 
   // The connection to the camera: the path camera -> hit -> ... -> light of segments + 1 segments.

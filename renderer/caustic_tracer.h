@@ -39,7 +39,7 @@
 
 namespace ember {
 
-class AreaLight;
+class Light;
 class Scene;
 struct BsdfSample;
 struct PathStats;
@@ -76,7 +76,7 @@ class CausticTracer {
   static constexpr size_t kMaxCasters = 64;
   CausticTracer() = default;
   // Enabled when there are casters (at most kMaxCasters), area lights and a perspective camera.
-  CausticTracer(std::vector<CausticCaster> casters, std::vector<const AreaLight*> lights, bool perspective,
+  CausticTracer(std::vector<CausticCaster> casters, std::vector<const Light*> lights, bool perspective,
                 float pathsPerPixel = 0.5f);
 
   bool enabled() const { return enabled_; }
@@ -108,6 +108,7 @@ class CausticTracer {
     int index = 0;           // the splat image (sample index within the pass)
     float pathsPerPixel = 1.0f;
     uint32_t rayMask = kAllRayMask;  // the Embree mask of `ray` (SurfaceHit::maskFor, Light::shadowMask)
+    float range = 0.0f;              // the first segment's light range (EmissionPoint::range); 0: none
   };
   // A connection to the camera: `value` goes to pixel (x, y) if `ray` is unblocked.
   struct Splat {
@@ -166,7 +167,7 @@ class CausticTracer {
   Cone cone(size_t i, const Vec3& from) const;
 
   std::vector<CausticCaster> casters_;
-  std::vector<const AreaLight*> lights_;
+  std::vector<const Light*> lights_;
   AliasTable lightChoice_;  // by power
   std::vector<float> lightPmf_;
   float pathsPerPixel_ = 0.5f;

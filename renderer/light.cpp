@@ -252,20 +252,24 @@ bool TriangleLight::sample(const Vec3& ref, Vec2 u, LightSample& out) const {
   out.pdf = st ? float(1.0 / st->solidAngle()) : areaToSolidAnglePdf(1.0f / area_, ref, p, ng_);
   out.delta = false;
   out.Li = twoSided_ || glm::dot(-out.wi, ng_) > 0.0f ? radiance_ : Color(0.0f);
-  if (texture_ || mesh_->opacity) {
-    if (texture_) {
-      // The texture as a hit there sees it: its own coordinate set, and COLOR_0 where it reads it.
-      SurfaceHit at;
-      at.uv = mesh_->uvAt(prim_, b.x, b.y);
-      at.attributes = mesh_;
-      at.prim = prim_;
-      at.bary = b;
-      out.Li *= texture_->evalFresh(at);
-    }
-    // Cut-out (MASK) or partly transparent (BLEND) parts emit as much as rays that hit them find.
-    if (mesh_->opacity) out.Li *= mesh_->opacity->coverage(*mesh_, prim_, b);
-  }
+  if (texture_ || mesh_->opacity) out.Li *= emissionFactorAt(b);
   return out.pdf > 0.0f && std::isfinite(out.pdf);
+}
+
+Color TriangleLight::emissionFactorAt(Vec2 b) const {
+  Color factor(1.0f);
+  if (texture_) {
+    // The texture as a hit there sees it: its own coordinate set, and COLOR_0 where it reads it.
+    SurfaceHit at;
+    at.uv = mesh_->uvAt(prim_, b.x, b.y);
+    at.attributes = mesh_;
+    at.prim = prim_;
+    at.bary = b;
+    factor *= texture_->evalFresh(at);
+  }
+  // Cut-out (MASK) or partly transparent (BLEND) parts emit as much as rays that hit them find.
+  if (mesh_->opacity) factor *= mesh_->opacity->coverage(*mesh_, prim_, b);
+  return factor;
 }
 
 EnvironmentLight::EnvironmentLight(std::shared_ptr<const ImageTexture> map, float rotateYDeg)
@@ -340,4 +344,59 @@ bool EnvironmentLight::sample(const Vec3&, Vec2 u, LightSample& out) const {
   out.Li = map_->eval(uv);
   return true;
 }
+}  // namespace ember
+
+namespace ember {
+
+// Light tracing's starting points (renderer/caustic_tracer.h). A point or spot light starts every
+// path at its position, with the intensity of the direction taken; a surface at a point uniform by
+// area, with its radiance times the cosine.
+
+bool PointLight::sampleEmission(Vec2, EmissionPoint& out) const {
+  out = EmissionPoint{position_, Vec3(0.0f), 0.0f, 1.0f, Color(1.0f), range_};
+  return true;
+}
+
+Color PointLight::emittedToward(const EmissionPoint& e, const Vec3&) const {
+  return intensity_ * e.scale;
+}
+
+bool SpotLight::sampleEmission(Vec2, EmissionPoint& out) const {
+  out = EmissionPoint{position_, Vec3(0.0f), 0.0f, 1.0f, Color(1.0f), range_};
+  return true;
+}
+
+Color SpotLight::emittedToward(const EmissionPoint& e, const Vec3& w) const {
+  return intensity_ * e.scale * falloff(glm::dot(w, direction_));
+}
+
+bool AreaLight::sampleEmission(Vec2 u, EmissionPoint& out) const {
+  const ShapeSample s = shape_->sampleArea(u);
+  const float area = shape_->area();
+  if (!(area > 0.0f) || !std::isfinite(area)) return false;
+  out = EmissionPoint{s.p, s.n, pError_, 1.0f / area, Color(1.0f), 0.0f};
+  return true;
+}
+
+Color AreaLight::emittedToward(const EmissionPoint& e, const Vec3& w) const {
+  const float c = glm::dot(w, e.n);
+  return twoSided_ || c > 0.0f ? radiance_ * (std::abs(c) * e.scale) : Color(0.0f);
+}
+
+bool TriangleLight::sampleEmission(Vec2 u, EmissionPoint& out) const {
+  if (!(area_ > 0.0f)) return false;
+  const Vec2 a = sampleUniformTriangle(u);  // barycentrics of vertices 0 and 1
+  const Vec2 b(a.y, 1.0f - a.x - a.y);
+  out = EmissionPoint{
+      pointOnTriangle(v_[0], v_[1], v_[2], b.x, b.y), ng_, pError_, 1.0f / area_, Color(1.0f), 0.0f};
+  // The emissive texture and the cut-out, as sample() reads them at its points.
+  if (texture_ || mesh_->opacity) out.scale = emissionFactorAt(b);
+  return true;
+}
+
+Color TriangleLight::emittedToward(const EmissionPoint& e, const Vec3& w) const {
+  const float c = glm::dot(w, e.n);
+  return twoSided_ || c > 0.0f ? radiance_ * (std::abs(c) * e.scale) : Color(0.0f);
+}
+
 }  // namespace ember

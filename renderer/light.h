@@ -29,9 +29,27 @@ struct LightSample {
   bool delta = false;
 };
 
+// Where a light path starts (renderer/caustic_tracer.h): a point on the emitter and the density it
+// was drawn with.
+struct EmissionPoint {
+  Vec3 p;
+  Vec3 n{0.0f};          // unit surface normal; zero for point and spot lights
+  float pError = 0.0f;   // rounding-error bound of p
+  float pdfArea = 1.0f;  // area density of p; 1 for point and spot lights (a Dirac in position)
+  Color scale{1.0f};     // a textured or cut-out emitter's factor at p
+  float range = 0.0f;    // KHR_lights_punctual range (rangeWindow) of the first segment; 0: none
+};
+
 class Light {
  public:
   virtual ~Light() = default;
+  // Light tracing: a point to start from, by u (uniform by area on a surface; the position of a
+  // point or spot light); false for lights no light path starts from (directional, environment).
+  virtual bool sampleEmission(Vec2, EmissionPoint&) const { return false; }
+  // What that point emits in unit direction w: radiance times |cos| to the normal on a surface
+  // (zero behind a one-sided one), intensity for a point or spot light: the flux per unit area (or
+  // per point) and solid angle the light tracer carries.
+  virtual Color emittedToward(const EmissionPoint&, const Vec3&) const { return Color(0.0f); }
   virtual bool sample(const Vec3& ref, Vec2 u, LightSample& out) const = 0;
   // Solid-angle density with which sample() from ref yields the point p with normal n.
   virtual float pdf(const Vec3& ref, const Vec3& p, const Vec3& n) const = 0;
@@ -76,6 +94,8 @@ class PointLight final : public Light {
   float pdf(const Vec3&, const Vec3&, const Vec3&) const override { return 0.0f; }
   Color power(float) const override { return 4.0f * kPi * intensity_; }
   bool isDelta() const override { return true; }
+  bool sampleEmission(Vec2 u, EmissionPoint& out) const override;
+  Color emittedToward(const EmissionPoint& e, const Vec3& w) const override;
   const Vec3& position() const { return position_; }
   const Color& intensity() const { return intensity_; }
   // A finite range (rangeWindow): the next-event kernel's whole-vector rows assume none.
@@ -99,6 +119,8 @@ class SpotLight final : public Light {
   SpotLight(const Vec3& position, const Vec3& direction, const Color& intensity, float innerRad,
             float outerRad, float range = 0.0f);
   bool sample(const Vec3& ref, Vec2 u, LightSample& out) const override;
+  bool sampleEmission(Vec2 u, EmissionPoint& out) const override;
+  Color emittedToward(const EmissionPoint& e, const Vec3& w) const override;
   float pdf(const Vec3&, const Vec3&, const Vec3&) const override { return 0.0f; }
   // Bounded by the power inside the outer cone.
   Color power(float) const override { return 2.0f * kPi * (1.0f - cosOuter_) * intensity_; }
@@ -149,6 +171,9 @@ class AreaLight final : public Light {
  public:
   AreaLight(const Shape* shape, const Color& radiance, bool twoSided = false);
   bool sample(const Vec3& ref, Vec2 u, LightSample& out) const override;
+  bool sampleEmission(Vec2 u, EmissionPoint& out) const override;
+  Color emittedToward(const EmissionPoint& e, const Vec3& w) const override;
+
   float pdf(const Vec3& ref, const Vec3& p, const Vec3& n) const override {
     return shape_->pdfSolidAngle(ref, p, n);
   }
@@ -204,6 +229,9 @@ class TriangleLight final : public Light {
   TriangleLight(const TriangleMesh* mesh, uint32_t prim, const Color& radiance,
                 const Texture* texture = nullptr, bool twoSided = false);
   bool sample(const Vec3& ref, Vec2 u, LightSample& out) const override;
+  bool sampleEmission(Vec2 u, EmissionPoint& out) const override;
+  Color emittedToward(const EmissionPoint& e, const Vec3& w) const override;
+
   // Seen from close by, uniform in the solid angle the triangle subtends (accel/spherical_triangle.h),
   // else uniform by area.
   float pdf(const Vec3& ref, const Vec3& p, const Vec3& n) const override;
@@ -220,6 +248,9 @@ class TriangleLight final : public Light {
   }
 
  private:
+  // The emissive texture times the cut-out's coverage at barycentrics b (1 without either).
+  Color emissionFactorAt(Vec2 b) const;
+
   const TriangleMesh* mesh_;
   uint32_t prim_;
   // The triangle's vertices and unit geometric normal (as TriangleMesh::surfaceAt computes it),

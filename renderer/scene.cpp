@@ -172,13 +172,18 @@ void Scene::build() {
     return std::isfinite(c.radius) && std::isfinite(c.center.x) && std::isfinite(c.center.y) &&
            std::isfinite(c.center.z);
   });
-  std::vector<const AreaLight*> areaLights;
-  for (const auto& light : lights)
-    if (const auto* area = dynamic_cast<const AreaLight*>(light.get())) areaLights.push_back(area);
-  causticTracer_ = CausticTracer(finite ? std::move(casters) : std::vector<CausticCaster>{},
-                                 std::move(areaLights), camera_.perspective(), settings.causticPathsPerPixel);
-  for (const auto& light : lights)
-    light->causticTraced = causticTracer_.enabled() && dynamic_cast<const AreaLight*>(light.get());
+  // Every light a path can start from (Light::sampleEmission): area lights, emissive triangles,
+  // point and spot lights.
+  std::vector<const Light*> emitters;
+  for (const auto& light : lights) {
+    EmissionPoint probe;
+    light->causticTraced = false;
+    if (light->sampleEmission(Vec2(0.5f), probe)) emitters.push_back(light.get());
+  }
+  causticTracer_ = CausticTracer(finite ? std::move(casters) : std::vector<CausticCaster>{}, emitters,
+                                 camera_.perspective(), settings.causticPathsPerPixel);
+  if (causticTracer_.enabled())
+    for (const Light* light : emitters) const_cast<Light*>(light)->causticTraced = true;
 }
 
 bool Scene::intersect(const Ray& ray, SurfaceHit& hit, uint32_t mask) const {

@@ -78,7 +78,8 @@ TEST(BenchCommand, TraceShareComesFromTheBatchedKernels) {
 // the report has no phases.
 TEST(BenchCommand, PhasesAddUpToTheRender) {
   test::TempDir dir;
-  const nlohmann::json scene = benchCornellPoint(dir, "phases.json", "--spp 2 --phases");
+  // Path-traced caustics: the phases time the path tracer's bounce, not the light tracer's waves.
+  const nlohmann::json scene = benchCornellPoint(dir, "phases.json", "--spp 2 --phases --caustics path");
   const nlohmann::json& phases = scene.at("phase_seconds");
   ASSERT_EQ(phases.size(), kPathPhases);
   double sum = 0.0;

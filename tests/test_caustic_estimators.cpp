@@ -13,6 +13,8 @@
 
 #include <gtest/gtest.h>
 
+#include "cli_runner.h"
+#include "gltf_builder.h"
 #include "test_fixtures.h"
 
 #include <filesystem>
@@ -111,11 +113,11 @@ TEST(CausticEstimators, PlanarMirrorAgreesWithThePathTracerAlone) {
   expectAgree(load(sceneJson(kMirrorMaterial, kMirrorShape, -1), "mirror"), "mirror");
 }
 
-// All the light the floor gets is a caustic: the light faces up, into a mirror ceiling. Seen
-// through a 100-degree lens, so that the camera's importance (1 / cos^3 per splat) is tested
-// far off the axis as well.
-TEST(CausticEstimators, LightOnlyThroughAMirrorAgreesAcrossAWideView) {
-  const std::string json = R"({
+// All the light the floor gets is a caustic: `light` (a shape entry) faces up, into a mirror
+// ceiling. Seen through a 100-degree lens, so that the camera's importance (1 / cos^3 per splat) is
+// tested far off the axis as well.
+std::string mirrorCeilingScene(const std::string& light) {
+  return R"({
     "image": {"width": 24, "height": 24},
     "camera": {"origin": [0, 0.9, 1.4], "target": [0, 0.2, -0.2], "up": [0, 1, 0], "fov_y_deg": 100},
     "render": {"max_depth": -1, "rr_depth": 3},
@@ -127,11 +129,16 @@ TEST(CausticEstimators, LightOnlyThroughAMirrorAgreesAcrossAWideView) {
     "shapes": [
       {"type": "quad", "material": "white", "vertices": [[-3, 0, 2], [3, 0, 2], [3, 0, -3], [-3, 0, -3]]},
       {"type": "quad", "material": "mirror", "vertices": [[-3, 2, -3], [3, 2, -3], [3, 2, 2], [-3, 2, 2]]},
-      {"type": "quad", "material": "black", "emission": [5, 5, 5],
-       "vertices": [[-0.5, 1.2, 0.3], [0.5, 1.2, 0.3], [0.5, 1.2, -0.7], [-0.5, 1.2, -0.7]]}
+      )" +
+         light + R"(
     ]
   })";
-  expectAgree(load(json, "mirror-only"), "light only through a mirror");
+}
+
+TEST(CausticEstimators, LightOnlyThroughAMirrorAgreesAcrossAWideView) {
+  const std::string quad = R"({"type": "quad", "material": "black", "emission": [5, 5, 5],
+       "vertices": [[-0.5, 1.2, 0.3], [0.5, 1.2, 0.3], [0.5, 1.2, -0.7], [-0.5, 1.2, -0.7]]})";
+  expectAgree(load(mirrorCeilingScene(quad), "mirror-only"), "light only through a mirror");
 }
 
 TEST(CausticEstimators, GlassSphereAgreesWithThePathTracerAlone) {
@@ -187,6 +194,84 @@ TEST(CausticEstimators, DoubleCountedCausticsAreRejected) {
   const BlockZTestResult r = compare(twice, alone);
   EXPECT_FALSE(r.passes());
   EXPECT_GT(r.failures, r.tests / 10) << "caustics should be visible in many blocks";
+}
+
+// An emissive glTF mesh (a one-sided square of TriangleLights) in place of that quad light, so
+// that all the floor's light is a caustic: the light tracer starts paths on its triangles
+// (Light::sampleEmission), and the path tracer leaves it the caustics of those lights.
+TEST(CausticEstimators, EmissiveMeshLightAgreesWithThePathTracerAlone) {
+  const test::TempDir dir;
+  test::GltfBuilder b;
+  tinygltf::Material m;
+  m.emissiveFactor = {1.0, 1.0, 1.0};
+  tinygltf::Value::Object strength{{"emissiveStrength", tinygltf::Value(5.0)}};
+  m.extensions["KHR_materials_emissive_strength"] = tinygltf::Value(strength);
+  b.model().extensionsUsed.push_back("KHR_materials_emissive_strength");
+  const std::vector<test::GltfBuilder::Vertex> v = {{{-0.5f, 1.2f, 0.3f}, {0, 1, 0}, {0, 0}, {1, 0, 0, 1}},
+                                                    {{0.5f, 1.2f, 0.3f}, {0, 1, 0}, {1, 0}, {1, 0, 0, 1}},
+                                                    {{0.5f, 1.2f, -0.7f}, {0, 1, 0}, {1, 1}, {1, 0, 0, 1}},
+                                                    {{-0.5f, 1.2f, -0.7f}, {0, 1, 0}, {0, 1}, {1, 0, 0, 1}}};
+  b.addMesh(v, {0, 1, 2, 0, 2, 3}, b.addMaterial(m));
+  const std::string light = dir.file("light.gltf");
+  ASSERT_TRUE(b.write(light));
+  const std::string json = mirrorCeilingScene(R"({"type": "mesh", "file": ")" + light + R"("})");
+  Scene scene = load(json, "mesh-light");
+  scene.build();
+  size_t traced = 0;
+  for (const auto& l : scene.lights) traced += l->causticTraced ? 1 : 0;
+  EXPECT_EQ(traced, 2u);  // the mesh's two triangles
+  expectAgree(std::move(scene), "emissive mesh light");
+}
+
+// A spot light just above a mirror floor, pointing down at it, under a white diffuse ceiling: the
+// ceiling gets no direct light, only the caustic of the spot's mirror image, R I / d'^2 at distance
+// d' from it. No path tracer reaches that light; the light tracer must give it exactly. The pixel
+// at the image centre sees the ceiling straight above the light, d' = 3 h: L = rho / pi R I / (3 h)^2.
+// Most light paths land outside the camera's view, hence many of them per pixel.
+TEST(CausticEstimators, SpotLightThroughAMirrorGivesItsMirrorImage) {
+  const float intensity = 2.0f, rho = 0.8f, reflectance = 0.9f, h = 1.0f;
+  const std::string json = R"({
+    "image": {"width": 15, "height": 15},
+    "camera": {"origin": [0, 1.0001, 0.02], "target": [0, 2, 0.02], "up": [0, 0, -1], "fov_y_deg": 60},
+    "render": {"max_depth": -1, "rr_depth": 10, "caustic_paths_per_pixel": 64},
+    "materials": {
+      "white": {"type": "diffuse", "reflectance": [0.8, 0.8, 0.8]},
+      "mirror": {"type": "mirror", "reflectance": [0.9, 0.9, 0.9]}
+    },
+    "lights": [{"type": "spot", "position": [0, 1, 0], "direction": [0, -1, 0], "intensity": [2, 2, 2],
+                "inner_deg": 40, "outer_deg": 45}],
+    "shapes": [
+      {"type": "quad", "material": "mirror", "vertices": [[-4, 0, 4], [4, 0, 4], [4, 0, -4], [-4, 0, -4]]},
+      {"type": "quad", "material": "white", "vertices": [[-4, 2, -4], [4, 2, -4], [4, 2, 4], [-4, 2, 4]]}
+    ]
+  })";
+  Scene scene = load(json, "spot-mirror");
+  scene.settings.traceCaustics = true;
+  scene.build();
+  ASSERT_TRUE(scene.causticTracer().enabled());
+  // One bounce: the ceiling's light that reaches the mirror again and comes back is the path
+  // tracer's, and depth 3 leaves it out.
+  scene.settings.maxDepth = 3;
+  const Film film = render(scene, *makeIntegrator(scene.settings, Kernel::Wave), 5);
+  const Image mean = film.mean(), variance = film.varianceOfMean();
+  // The 3 x 3 pixels at the centre, each against the closed form at the point its centre sees.
+  double got = 0.0, expected = 0.0, var = 0.0;
+  for (int y = 6; y <= 8; ++y)
+    for (int x = 6; x <= 8; ++x) {
+      const Ray ray = scene.camera().generateRay(float(x) + 0.5f, float(y) + 0.5f);
+      const Vec3 q = ray.origin + ((2.0f * h - ray.origin.y) / ray.dir.y) * ray.dir;
+      const Vec3 r = q - Vec3(0.0f, -h, 0.0f);  // from the mirror image of the light
+      const double d2 = double(glm::dot(r, r)), cosine = double(r.y) / std::sqrt(d2);
+      expected += double(rho) / double(kPi) * double(reflectance * intensity) * cosine / d2;
+      got += mean.at(x, y).x;
+      var += variance.at(x, y).x;
+    }
+  const double z = (got - expected) / std::sqrt(var);
+  EXPECT_LT(std::abs(z), 4.0) << got / 9.0 << " against " << expected / 9.0 << " (z " << z << ")";
+  // Without the light tracer the ceiling stays black.
+  scene.settings.traceCaustics = false;
+  const Film path = render(scene, *makeIntegrator(scene.settings, Kernel::Wave), 6);
+  EXPECT_EQ(path.mean().at(7, 7), Color(0.0f));
 }
 
 }  // namespace

@@ -194,7 +194,7 @@ TEST(CommandLine, InfoSaysHowCausticsAreEstimated) {
   EXPECT_NE(area.output.find("caustics:   light-traced, 2 specular object(s)"), std::string::npos)
       << area.output;
   const auto point = test::runEmber("info '" + test::sourcePath("scenes/cornell-point.json") + "'");
-  EXPECT_NE(point.output.find("caustics:   path-traced (no area light to trace from)"), std::string::npos)
+  EXPECT_NE(point.output.find("caustics:   light-traced, 2 specular object(s)"), std::string::npos)
       << point.output;
   const auto shapes = test::runEmber("info '" + test::sourcePath("scenes/shapes.json") + "'");
   EXPECT_NE(shapes.output.find("caustics:   path-traced (no mirror or glass)"), std::string::npos)
