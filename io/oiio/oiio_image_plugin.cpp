@@ -125,20 +125,19 @@ oiio::ImageInput* createMemoryInput() {
   return new MemoryInput;
 }
 
-// One texture system for the process, destroyed at exit (so that leak checkers see it freed).
+// One texture system for the process, kept until it exits: OpenImageIO 2.4's
+// TextureSystem::destroy deletes its implementation through a pointer of another type (AddressSanitizer:
+// new-delete-type-mismatch), and a static pointer keeps everything it holds reachable.
 oiio::TextureSystem& textureSystem() {
-  struct Owner {
-    oiio::TextureSystem* ts;
-    Owner() : ts(oiio::TextureSystem::create(/*shared=*/false)) {
-      // MIP levels made on first use for images that have none, kept in 64x64 tiles.
-      ts->attribute("automip", 1);
-      ts->attribute("autotile", 64);
-      ts->attribute("max_memory_MB", 1024.0f);
-    }
-    ~Owner() { oiio::TextureSystem::destroy(ts); }
-  };
-  static Owner owner;
-  return *owner.ts;
+  static oiio::TextureSystem* const ts = [] {
+    oiio::TextureSystem* t = oiio::TextureSystem::create(/*shared=*/false);
+    // MIP levels made on first use for images that have none, kept in 64x64 tiles.
+    t->attribute("automip", 1);
+    t->attribute("autotile", 64);
+    t->attribute("max_memory_MB", 1024.0f);
+    return t;
+  }();
+  return *ts;
 }
 
 oiio::TextureOpt::Wrap oiioWrap(ImagePlugin::Wrap w) {
