@@ -259,13 +259,23 @@ RawPixels readPlugin(const std::string& path, const ImagePlugin& plugin) {
   return raw;
 }
 
+// The file's first bytes, enough to tell a PFM (isPfm) before reading the whole file.
+std::vector<unsigned char> fileHead(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open");
+  std::vector<unsigned char> head(3);
+  in.read(reinterpret_cast<char*>(head.data()), std::streamsize(head.size()));
+  head.resize(size_t(in.gcount()));
+  return head;
+}
+
 RawPixels readRaw(const std::string& path) {
   checkExists(path);
   if (Imf::isOpenExrFile(path.c_str())) return readExr(path);
-  const std::vector<unsigned char> bytes = fileBytes(path);
-  if (isPfm(bytes)) return readPfm(path, bytes);
+  if (isPfm(fileHead(path))) return readPfm(path, fileBytes(path));
+  // The plugin reads the file itself: no copy of it here.
   if (const ImagePlugin* plugin = imagePlugin()) return readPlugin(path, *plugin);
-  return readStb(path, bytes);
+  return readStb(path, fileBytes(path));
 }
 
 Color pixelRgb(const float* p, int channels) {
