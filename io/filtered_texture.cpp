@@ -15,18 +15,15 @@ FilteredImageTexture::FilteredImageTexture(const ImagePlugin& plugin, const std:
       scale_(scale),
       id_(newHitMemoOwner()) {
   rgb_.reserve(texels.size() * 3);
-  Color sum(0.0f);
+  // A filtered value is a weighted mean of texels: black only where some texel may be.
+  TexelStatistics stats;
   for (const Color& c : texels) {
     rgb_.insert(rgb_.end(), {c.x, c.y, c.z});
-    const Color scaled = c * scale_;
-    max_ = glm::max(max_, scaled);
-    sum += scaled;
-    const bool positive = scaled.x > 0.0f || scaled.y > 0.0f || scaled.z > 0.0f;
-    const bool negative = scaled.x < 0.0f || scaled.y < 0.0f || scaled.z < 0.0f;
-    // A filtered value is a weighted mean of texels: black only where some texel is.
-    mayBeBlack_ = mayBeBlack_ || !positive || negative;
+    stats.add(c * scale_);
   }
-  if (!texels.empty()) average_ = sum / float(texels.size());
+  max_ = stats.max;
+  average_ = stats.average();
+  mayBeBlack_ = stats.mayBeBlack;
   handle_ = plugin_.addTexture(rgb_.data(), width, height);
   if (!handle_) throw InputError(name + ": OpenImageIO's texture system cannot take the image");
 }

@@ -100,9 +100,9 @@ ImageTexture::ImageTexture(int width, int height, std::vector<Color> texels, Tex
       wrapT_(wrapT),
       scale_(scale),
       id_(newHitMemoOwner()) {
-  Color sum(0.0f);
-  for (const Color& c : texels_) addStatistics(c, sum);
-  if (!texels_.empty()) average_ = sum / float(texels_.size());
+  TexelStatistics stats;
+  for (const Color& c : texels_) stats.add(c * scale_);
+  keepStatistics(stats);
 
   // First the palettes, which an HDR image overflows within its first few hundred texels; the
   // indices only once they fit. A colour palette first: one byte per texel.
@@ -149,7 +149,7 @@ ImageTexture::ImageTexture(int width, int height, const ByteChannels& in, Textur
   // Each channel's palette is its table; a texel's index is its byte (0 for a constant channel).
   for (size_t c = 0; c < 3; ++c) palette_[c] = in.tables[c];
   indices_.resize(3 * n);
-  Color sum(0.0f);
+  TexelStatistics stats;
   for (size_t i = 0; i < n; ++i) {
     const uint8_t* texel = in.bytes + i * size_t(in.stride);
     Color value;
@@ -158,9 +158,9 @@ ImageTexture::ImageTexture(int width, int height, const ByteChannels& in, Textur
       indices_[3 * i + c] = b;
       value[int(c)] = palette_[c][b];
     }
-    addStatistics(value, sum);
+    stats.add(value * scale_);
   }
-  if (n > 0) average_ = sum / float(n);
+  keepStatistics(stats);
   paletted_ = true;
   // As the float constructor does: one byte per texel where at most 256 colours occur.
   ColorPalette colors;

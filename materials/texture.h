@@ -51,6 +51,25 @@ class ConstantTexture final : public Texture {
   Color value_;
 };
 
+// What an image texture reports of its scaled texels (maxValue, average, mayBeBlack), gathered texel
+// by texel in the image's order (inline: it runs per texel at load).
+struct TexelStatistics {
+  Color max{0.0f}, sum{0.0f};
+  size_t count = 0;
+  // Some scaled texel is black or has a negative channel (whose blend with another texel could
+  // then be black): a blend of texels with neither always has a positive channel.
+  bool mayBeBlack = false;
+  void add(const Color& scaled) {
+    max = glm::max(max, scaled);
+    sum += scaled;
+    ++count;
+    const bool positive = scaled.x > 0.0f || scaled.y > 0.0f || scaled.z > 0.0f;
+    const bool negative = scaled.x < 0.0f || scaled.y < 0.0f || scaled.z < 0.0f;
+    mayBeBlack = mayBeBlack || !positive || negative;
+  }
+  Color average() const { return count ? sum / float(count) : Color(0.0f); }
+};
+
 enum class TextureFilter { Nearest, Bilinear };
 enum class TextureWrap { Clamp, Repeat, Mirror };
 
@@ -92,14 +111,10 @@ class ImageTexture final : public Texture {
  private:
   Color texel(int x, int y) const;    // (x, y) wrapped into the image first
   Color texelAt(int x, int y) const;  // (x, y) inside the image
-  // max_, mayBeBlack_ and the sum for average_, texel by texel (inline: it runs per texel at load).
-  void addStatistics(const Color& texel, Color& sum) {
-    const Color scaled = texel * scale_;
-    max_ = glm::max(max_, scaled);
-    sum += scaled;
-    const bool positive = scaled.x > 0.0f || scaled.y > 0.0f || scaled.z > 0.0f;
-    const bool negative = scaled.x < 0.0f || scaled.y < 0.0f || scaled.z < 0.0f;
-    mayBeBlack_ = mayBeBlack_ || !positive || negative;
+  void keepStatistics(const TexelStatistics& stats) {
+    max_ = stats.max;
+    average_ = stats.average();
+    mayBeBlack_ = stats.mayBeBlack;
   }
 
   int width_, height_;
