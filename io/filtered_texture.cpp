@@ -22,6 +22,7 @@ FilteredImageTexture::FilteredImageTexture(const ImagePlugin& plugin, const std:
     stats.add(c * scale_);
   }
   max_ = stats.max;
+  min_ = stats.minimum();
   average_ = stats.average();
   mayBeBlack_ = stats.mayBeBlack;
   handle_ = plugin_.addTexture(rgb_.data(), width, height);

@@ -27,6 +27,7 @@ class FilteredImageTexture final : public Texture {
   Color evalAt(const SurfaceHit& hit) const override;
   Color evalFresh(const SurfaceHit& hit) const override { return lookup(hit.uv, hit.uvFootprint); }
   Color maxValue() const override { return max_; }
+  Color minValue() const override { return min_; }
   Color average() const override { return average_; }
   bool mayBeBlack() const override { return mayBeBlack_; }
 
@@ -38,7 +39,7 @@ class FilteredImageTexture final : public Texture {
   const void* handle_;
   ImagePlugin::Wrap wrap_;
   Color scale_;
-  Color max_{0.0f}, average_{0.0f};
+  Color max_{0.0f}, min_{0.0f}, average_{0.0f};
   bool mayBeBlack_ = false;
   uint64_t id_;  // evalAt's memo key (materials/hit_memo.h)
 };

@@ -3,8 +3,18 @@
 //
 //  - Inputs: a missing baseColor or metallicRoughness texture means glTF's default factors (1);
 //    roughness, metallic and transmission are clamped to [0, 1], the base colour to >= 0, ior to
-//    >= 1. alpha = roughness^2 is clamped to Ggx::kMinAlpha = 1e-3 (microfacet.h says why), so a
-//    roughness of 0 renders as a very sharp, not a Dirac, lobe and hasNonDeltaLobes() stays true.
+//    >= 1. alpha = roughness^2 is clamped to Ggx::kMinAlpha = 1e-3 (microfacet.h says why).
+//  - Smooth surfaces: where alpha is at that clamp (roughness <= 0.0316, isotropic), the specular
+//    reflection and the transmission are Dirac lobes, and so is the coat where its own roughness
+//    is. Each is its microfacet lobe's limit as alpha -> 0: the integral of D V |cos theta_i|
+//    over the lobe tends to 1 (D to a delta about n, G2 to 1), leaving the lobe's Fresnel weights
+//    at n.v: a mirror weighted dielectric w Fd + metallic Fm (and the coat's clearcoat F_c),
+//    thin-walled transmission straight through with dielectric t (1 - w max3(Fd)) baseColor, and
+//    refraction with dielectric t (1 - F) baseColor / eta^2 (the radiance scaling, as Dielectric
+//    in specular.h). The diffuse and sheen lobes are unchanged; the lobe probabilities are the
+//    same, a Dirac lobe's being its sample's pdf. So glTF glass and polished metal cast caustics
+//    that the light tracer can follow (renderer/caustic_tracer.h), and the path tracer's images
+//    are those of the alpha -> 0 limit rather than of alpha = 1e-3.
 //  - Reflection is two-sided, like Lambertian: the shading frame is the shading normal turned to
 //    wo's side of the geometric normal, and wi must lie on that side of both (sameSide on hit.ng,
 //    positive cosine with the shading normal).
@@ -94,6 +104,25 @@ GltfPbrMaterial::GltfPbrMaterial(GltfPbrInputs inputs) : inputs_(std::move(input
   coat_ = inputs_.clearcoat && inputs_.clearcoat->maxValue().x > 0.0f;
   film_ = inputs_.iridescence && inputs_.iridescence->maxValue().x > 0.0f;
   anisotropic_ = inputs_.anisotropyStrength > 0.0f;
+
+  // Where a roughness can reach the clamp (anisotropy only widens the lobe, so it is ignored
+  // here: the test is for "may be smooth").
+  const float smoothRoughness = std::sqrt(Ggx::kMinAlpha);
+  const auto smoothSomewhere = [&](const std::shared_ptr<const Texture>& t, int channel, float absent) {
+    return (t ? t->minValue()[channel] : absent) <= smoothRoughness;
+  };
+  const auto smoothEverywhere = [&](const std::shared_ptr<const Texture>& t, int channel, float absent) {
+    return (t ? t->maxValue()[channel] : absent) <= smoothRoughness;
+  };
+  deltaLobes_ = smoothSomewhere(inputs_.metallicRoughness, 1, 1.0f) ||
+                (coat_ && smoothSomewhere(inputs_.clearcoatRoughness, 0, 0.0f));
+  // Only Dirac lobes: a smooth metal, or smooth glass that transmits all it does not reflect,
+  // without a sheen or a rough coat. Then no light sample is worth a shadow ray.
+  const bool noDiffuse =
+      (inputs_.metallicRoughness ? inputs_.metallicRoughness->minValue().b : 1.0f) >= 1.0f ||
+      (inputs_.transmission && inputs_.transmission->minValue().r >= 1.0f);
+  nonDeltaLobes_ = !(smoothEverywhere(inputs_.metallicRoughness, 1, 1.0f) && !anisotropic_ && !sheen_ &&
+                     (!coat_ || smoothEverywhere(inputs_.clearcoatRoughness, 0, 0.0f)) && noDiffuse);
 }
 
 const GltfPbrMaterial::Params& GltfPbrMaterial::fetchFor(const SurfaceHit& hit) const {
@@ -135,6 +164,8 @@ GltfPbrMaterial::Params GltfPbrMaterial::fetch(const SurfaceHit& hit) const {
     p.coatNormal = glm::dot(n, hit.ng) < 0.0f ? -n : n;
   }
   if (anisotropic_) fetchAnisotropy(hit, roughness, p);
+  p.smooth = std::max(p.ggx.alphaX, p.ggx.alphaY) <= Ggx::kMinAlpha;
+  p.coatSmooth = coat_ && p.coatGgx.alphaX <= Ggx::kMinAlpha;
   if (film_) {
     p.iridescence = std::clamp(inputs_.iridescence->evalFresh(hit).r, 0.0f, 1.0f);
     const float t = inputs_.iridescenceThickness
@@ -265,14 +296,16 @@ Color GltfPbrMaterial::evalBase(const Params& p, const LobeProbabilities& lobes,
     fd *= p.specularWeight;
     // mix(fresnel_mix(base, specular), conductor_fresnel(specular), metallic), base = the diffuse
     // part only (the BTDF is zero for a reflection).
-    const Color f =
-        dielectric * ((1.0f - maxOf(fd)) * (1.0f - p.transmission) * kInvPi * p.baseColor + fd * specular) +
-        p.metallic * specular * fm;
-    pdf = lobes.diffuse * cosineHemispherePdf(i.z) + lobes.specular * g.reflectionPdf(o, h);
+    // A smooth surface's specular lobe is a Dirac delta (see the top comment): not evaluated here.
+    const Color diffuse = dielectric * (1.0f - maxOf(fd)) * (1.0f - p.transmission) * kInvPi * p.baseColor;
+    pdf = lobes.diffuse * cosineHemispherePdf(i.z);
+    if (p.smooth) return diffuse * i.z;
+    const Color f = diffuse + dielectric * fd * specular + p.metallic * specular * fm;
+    pdf += lobes.specular * g.reflectionPdf(o, h);
     return f * i.z;
   }
 
-  if (!(i.z < 0.0f) || !(p.transmission > 0.0f) || !(dielectric > 0.0f)) return Color(0.0f);
+  if (p.smooth || !(i.z < 0.0f) || !(p.transmission > 0.0f) || !(dielectric > 0.0f)) return Color(0.0f);
   const float scale = dielectric * p.transmission;
   if (!refracts_) {
     // Thin-walled: the reflection lobe of the mirrored direction (flip along the normal).
@@ -310,32 +343,36 @@ Color GltfPbrMaterial::evalBase(const Params& p, const LobeProbabilities& lobes,
   return (scale * (1.0f - F) * g.D(h) * g2OverCosO * -cosIH * cosOH / len2) * p.baseColor;
 }
 
+float GltfPbrMaterial::baseScale(const Params& p, const Frames& f, float iz) const {
+  if (!f.layers) return 1.0f;
+  float scale = 1.0f;
+  if (sheen_) {
+    // Albedo scaling of the base (Estevez & Kulla 2017, section 4; the extension's
+    // sheenAlbedoScaling), clamped at 0: towards grazing angles E exceeds 1 (materials/sheen.h).
+    const float m = maxOf(p.sheenColor);
+    scale = std::max(0.0f, std::min(1.0f - m * sheenAlbedo(f.o.z, p.sheenRoughness),
+                                    1.0f - m * sheenAlbedo(iz, p.sheenRoughness)));
+  }
+  if (coat_) scale *= 1.0f - coatWeight(p, f);
+  return scale;
+}
+
 Color GltfPbrMaterial::evalLayers(const Params& p, const LobeProbabilities& lobes, const Frames& f,
                                   const SurfaceHit& hit, const Vec3& wo, const Vec3& wi, float& pdf) const {
   const bool reflection = sameSide(hit, wo, wi);
   const Vec3 i = f.base.toLocal(wi);
-  Color result = evalBase(p, lobes, f.o, i, reflection, f.outside, pdf);
+  Color result = evalBase(p, lobes, f.o, i, reflection, f.outside, pdf) * baseScale(p, f, i.z);
   if (!f.layers) return result;
-  if (sheen_) {
-    // Albedo scaling of the base (Estevez & Kulla 2017, section 4; the extension's
-    // sheenAlbedoScaling), then the sheen lobe itself for a reflection.
-    const float m = maxOf(p.sheenColor);
-    // Clamped at 0: towards grazing angles E exceeds 1 (materials/sheen.h).
-    const float scaling = std::max(0.0f, std::min(1.0f - m * sheenAlbedo(f.o.z, p.sheenRoughness),
-                                                  1.0f - m * sheenAlbedo(i.z, p.sheenRoughness)));
-    result *= scaling;
-    if (reflection && i.z > 0.0f) {
-      result += CharlieSheen(p.sheenRoughness).evalCos(f.o, i) * p.sheenColor;
-      pdf += lobes.sheen * (0.5f * kInvPi);
-    }
+  const float coat = coatWeight(p, f);
+  if (sheen_ && reflection && i.z > 0.0f) {
+    result += (1.0f - coat) * CharlieSheen(p.sheenRoughness).evalCos(f.o, i) * p.sheenColor;
+    pdf += lobes.sheen * (0.5f * kInvPi);
   }
-  if (coat_) {
-    const float weight = coatWeight(p, f);
-    result *= 1.0f - weight;
+  if (coat_ && !p.coatSmooth) {
     const Vec3 ic = f.coat.toLocal(wi);
-    if (reflection && weight > 0.0f && ic.z > 0.0f) {
+    if (reflection && coat > 0.0f && ic.z > 0.0f) {
       const Vec3 h = glm::normalize(f.oc + ic);
-      result += Color(weight * p.coatGgx.D(h) * p.coatGgx.V(f.oc, ic) * ic.z);
+      result += Color(coat * p.coatGgx.D(h) * p.coatGgx.V(f.oc, ic) * ic.z);
       pdf += lobes.coat * p.coatGgx.reflectionPdf(f.oc, h);
     }
   }
@@ -376,6 +413,7 @@ bool GltfPbrMaterial::sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, floa
   float eta = 1.0f;
   float edge = lobes.coat;
   if (uLobe < edge) {
+    if (p.coatSmooth) return sampleDelta(p, lobes, f, hit, wo, 0, out);
     const Vec3 ic = reflect(f.oc, p.coatGgx.sampleVisibleNormal(f.oc, u));
     if (!(ic.z > 0.0f)) return false;  // under the coat's horizon: absorbed, as the base's lobes
     wi = f.coat.toWorld(ic);
@@ -391,6 +429,7 @@ bool GltfPbrMaterial::sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, floa
     const float rest = uLobe - edge;
     const bool specular = rest < lobes.specular || (!(lobes.diffuse > 0.0f) && !(lobes.transmission > 0.0f));
     const bool diffuse = !specular && (rest < lobes.specular + lobes.diffuse || !(lobes.transmission > 0.0f));
+    if (p.smooth && !diffuse) return sampleDelta(p, lobes, f, hit, wo, specular ? 1 : 2, out);
     Vec3 i;
     if (specular) {
       i = reflect(o, p.ggx.sampleVisibleNormal(o, u));
@@ -421,6 +460,53 @@ bool GltfPbrMaterial::sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, floa
   out.weight = fval / out.pdf;
   out.delta = false;
   out.eta = transmit ? eta : 1.0f;
+  return true;
+}
+
+bool GltfPbrMaterial::sampleDelta(const Params& p, const LobeProbabilities& lobes, const Frames& f,
+                                  const SurfaceHit& hit, const Vec3& wo, int lobe, BsdfSample& out) const {
+  // Each lobe's alpha -> 0 limit (see the top comment).
+  Color value;
+  float probability, eta = 1.0f;
+  Vec3 wi;
+  if (lobe == 0) {
+    wi = f.coat.toWorld(Vec3(-f.oc.x, -f.oc.y, f.oc.z));
+    value = Color(coatWeight(p, f));
+    probability = lobes.coat;
+  } else {
+    const Vec3& o = f.o;
+    const float dielectric = 1.0f - p.metallic;
+    Color fd, fm;
+    reflectances(p, o.z, f.outside, fd, fm);
+    Vec3 i;
+    if (lobe == 1) {
+      i = Vec3(-o.x, -o.y, o.z);
+      value = dielectric * p.specularWeight * fd + p.metallic * fm;
+      probability = lobes.specular;
+    } else {
+      const float scale = dielectric * p.transmission;
+      if (!refracts_) {
+        i = -o;
+        value = (scale * (1.0f - p.specularWeight * maxOf(fd))) * p.baseColor;
+      } else {
+        eta = f.outside ? ior_ : 1.0f / ior_;
+        // Total internal reflection: the specular lobe, with F = 1, carries it.
+        if (!refract(o, Vec3(0.0f, 0.0f, 1.0f), eta, i)) return false;
+        const float F = p.specularWeight * maxOf(schlickFresnel(p.specularF0, f.outside ? o.z : -i.z));
+        value = (scale * (1.0f - F) / (eta * eta)) * p.baseColor;
+      }
+      probability = lobes.transmission;
+    }
+    value *= baseScale(p, f, i.z);
+    wi = f.base.toWorld(i);
+  }
+  if (!(probability > 0.0f)) return false;
+  out.wi = glm::normalize(wi);
+  if (sameSide(hit, wo, out.wi) == (lobe == 2)) return false;  // crossed the geometric surface the wrong way
+  out.weight = value / probability;
+  out.pdf = probability;
+  out.delta = true;
+  out.eta = lobe == 2 ? eta : 1.0f;
   return true;
 }
 

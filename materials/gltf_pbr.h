@@ -85,6 +85,8 @@ class GltfPbrMaterial final : public Material {
     return evalAndPdf(hit, wo, wi, pdfOut);
   }
   bool sample(const SurfaceHit& hit, const Vec3& wo, Vec2 u, float uLobe, BsdfSample& out) const override;
+  // Where the roughness (or the coat's) can be 0: those lobes are then Dirac (gltf_pbr.cpp).
+  bool hasDeltaLobes() const override { return deltaLobes_; }
 
   // Beer-Lambert through the volume (KHR_materials_volume): exp(-sigma d).
   Color interiorTransmittance(float distance) const override {
@@ -105,6 +107,9 @@ class GltfPbrMaterial final : public Material {
     float sheenRoughness = 0.0f;
     float clearcoat = 0.0f;
     Ggx coatGgx = Ggx::fromRoughness(0.0f);
+    // The base's specular and transmission lobes, and the coat's, are Dirac deltas here: their
+    // alphas are at Ggx::kMinAlpha.
+    bool smooth = false, coatSmooth = false;
     Vec3 coatNormal{0.0f};                           // world space, on the side of hit.ng
     float iridescence = 0.0f, filmThickness = 0.0f;  // nm
     Vec3 anisotropyDirection{0.0f};                  // world space, where ggx is anisotropic: its x axis
@@ -143,6 +148,12 @@ class GltfPbrMaterial final : public Material {
   // surface.
   Color evalBase(const Params& p, const LobeProbabilities& lobes, const Vec3& o, const Vec3& i,
                  bool reflection, bool outside, float& pdf) const;
+  // What the sheen and the coat leave of the base for a direction of local cosine iz: the base's
+  // lobes are multiplied by it.
+  float baseScale(const Params& p, const Frames& f, float iz) const;
+  // sample() through a Dirac lobe (lobe: 0 coat, 1 specular, 2 transmission).
+  bool sampleDelta(const Params& p, const LobeProbabilities& lobes, const Frames& f, const SurfaceHit& hit,
+                   const Vec3& wo, int lobe, BsdfSample& out) const;
   // The whole layered BSDF, f |cos theta_i|, and sample()'s mixture pdf for world direction wi.
   Color evalLayers(const Params& p, const LobeProbabilities& lobes, const Frames& f, const SurfaceHit& hit,
                    const Vec3& wo, const Vec3& wi, float& pdf) const;
@@ -152,6 +163,7 @@ class GltfPbrMaterial final : public Material {
   float ior_;  // max(ior, 1)
   float f0_;   // ((ior - 1) / (ior + 1))^2, the dielectric's normal-incidence reflectance
   bool sheen_, coat_, film_, anisotropic_;  // the layers are present
+  bool deltaLobes_;                         // some hit may be smooth (Params::smooth or coatSmooth)
   bool refracts_;  // a volumetric (bending) transmission lobe: !thinWalled and ior_ > 1
   uint64_t id_;    // fetchFor's memo key: newHitMemoOwner()
 };

@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -26,6 +27,8 @@ class Texture {
   virtual Color evalFresh(const SurfaceHit& hit) const { return eval(hit.texCoord(texCoordSet())); }
   // Largest value the texture can return per channel (used for sampling decisions).
   virtual Color maxValue() const = 0;
+  // Smallest value it can return per channel (whether a roughness map reaches 0 somewhere).
+  virtual Color minValue() const = 0;
   // Mean over the texture's area.
   virtual Color average() const = 0;
   // The same value at every uv.
@@ -43,6 +46,7 @@ class ConstantTexture final : public Texture {
   Color eval(Vec2) const override { return value_; }
   Color evalAt(const SurfaceHit&) const override { return value_; }
   Color maxValue() const override { return value_; }
+  Color minValue() const override { return value_; }
   Color average() const override { return value_; }
   bool isConstant() const override { return true; }
   bool mayBeBlack() const override { return isBlack(value_); }
@@ -51,16 +55,18 @@ class ConstantTexture final : public Texture {
   Color value_;
 };
 
-// What an image texture reports of its scaled texels (maxValue, average, mayBeBlack), gathered texel
-// by texel in the image's order (inline: it runs per texel at load).
+// What an image texture reports of its scaled texels (maxValue, minValue, average, mayBeBlack),
+// gathered texel by texel in the image's order (inline: it runs per texel at load). Every lookup
+// (nearest, bilinear, a MIP level's box filter) is a convex blend of texels, so their bounds hold.
 struct TexelStatistics {
-  Color max{0.0f}, sum{0.0f};
+  Color max{0.0f}, min{std::numeric_limits<float>::infinity()}, sum{0.0f};
   size_t count = 0;
   // Some scaled texel is black or has a negative channel (whose blend with another texel could
   // then be black): a blend of texels with neither always has a positive channel.
   bool mayBeBlack = false;
   void add(const Color& scaled) {
     max = glm::max(max, scaled);
+    min = glm::min(min, scaled);
     sum += scaled;
     ++count;
     const bool positive = scaled.x > 0.0f || scaled.y > 0.0f || scaled.z > 0.0f;
@@ -68,6 +74,7 @@ struct TexelStatistics {
     mayBeBlack = mayBeBlack || !positive || negative;
   }
   Color average() const { return count ? sum / float(count) : Color(0.0f); }
+  Color minimum() const { return count ? min : Color(0.0f); }
 };
 
 enum class TextureFilter { Nearest, Bilinear };
@@ -99,6 +106,7 @@ class ImageTexture final : public Texture {
   Color eval(Vec2 uv) const override;
   Color evalAt(const SurfaceHit& hit) const override;
   Color maxValue() const override { return max_; }
+  Color minValue() const override { return min_; }
   Color average() const override { return average_; }
   bool mayBeBlack() const override { return mayBeBlack_; }
   int width() const { return width_; }
@@ -113,6 +121,7 @@ class ImageTexture final : public Texture {
   Color texelAt(int x, int y) const;  // (x, y) inside the image
   void keepStatistics(const TexelStatistics& stats) {
     max_ = stats.max;
+    min_ = stats.minimum();
     average_ = stats.average();
     mayBeBlack_ = stats.mayBeBlack;
   }
@@ -132,7 +141,7 @@ class ImageTexture final : public Texture {
   TextureFilter filter_;
   TextureWrap wrapS_, wrapT_;
   Color scale_;
-  Color max_{0.0f}, average_{0.0f};
+  Color max_{0.0f}, min_{0.0f}, average_{0.0f};
   // Some scaled texel is black or has a negative channel (whose bilinear blend with another texel
   // could then be black): a blend of texels with neither always has a positive channel.
   bool mayBeBlack_ = false;
@@ -152,6 +161,7 @@ class UvTransformTexture final : public Texture {
     return inner_->eval(Vec2(glm::dot(row0_, uv), glm::dot(row1_, uv)) + offset_);
   }
   Color maxValue() const override { return inner_->maxValue(); }
+  Color minValue() const override { return inner_->minValue(); }
   Color average() const override { return inner_->average(); }
   bool mayBeBlack() const override { return inner_->mayBeBlack(); }
 
@@ -168,6 +178,7 @@ class TexCoordSetTexture final : public Texture {
   Color eval(Vec2 uv) const override { return inner_->eval(uv); }
   Color evalAt(const SurfaceHit& hit) const override { return inner_->eval(hit.texCoord(set_)); }
   Color maxValue() const override { return inner_->maxValue(); }
+  Color minValue() const override { return inner_->minValue(); }
   Color average() const override { return inner_->average(); }
   bool isConstant() const override { return inner_->isConstant(); }
   bool mayBeBlack() const override { return inner_->mayBeBlack(); }
@@ -191,6 +202,7 @@ class VertexColorTexture final : public Texture {
     return inner_->evalAt(hit) * Color(hit.vertexColor());
   }
   Color maxValue() const override { return inner_->maxValue(); }
+  Color minValue() const override { return glm::min(inner_->minValue(), Color(0.0f)); }
   Color average() const override { return inner_->average(); }
   bool mayBeBlack() const override { return true; }
   int texCoordSet() const override { return inner_->texCoordSet(); }

@@ -223,6 +223,41 @@ TEST(CausticEstimators, EmissiveMeshLightAgreesWithThePathTracerAlone) {
   expectAgree(std::move(scene), "emissive mesh light");
 }
 
+// glTF glass (KHR_materials_transmission and _volume at roughness 0: a Dirac refraction, so the
+// mesh is a caster) and a glTF polished metal plate (metallic 1, roughness 0), both with a
+// colour, under the quad light: the light tracer follows their Dirac lobes from the light, and
+// the path tracer must agree.
+TEST(CausticEstimators, GltfGlassAndPolishedMetalAgreeWithThePathTracerAlone) {
+  const test::TempDir dir;
+  test::GltfBuilder b;
+  using V = tinygltf::Value;
+  tinygltf::Material glass;
+  glass.pbrMetallicRoughness.baseColorFactor = {1.0, 0.9, 0.8, 1.0};
+  glass.pbrMetallicRoughness.metallicFactor = 0.0;
+  glass.pbrMetallicRoughness.roughnessFactor = 0.0;
+  glass.extensions["KHR_materials_transmission"] = V(V::Object{{"transmissionFactor", V(1.0)}});
+  glass.extensions["KHR_materials_volume"] = V(V::Object{{"thicknessFactor", V(0.8)}});
+  tinygltf::Material metal;
+  metal.pbrMetallicRoughness.baseColorFactor = {0.9, 0.8, 0.6, 1.0};
+  metal.pbrMetallicRoughness.metallicFactor = 1.0;
+  metal.pbrMetallicRoughness.roughnessFactor = 0.0;
+  b.model().extensionsUsed = {"KHR_materials_transmission", "KHR_materials_volume"};
+  const float center[3] = {0.5f, 0.75f, -0.2f};
+  b.addSphere(center, 0.4f, b.addMaterial(glass), 32, 64);
+  const std::vector<test::GltfBuilder::Vertex> plate = {
+      {{-1.2f, 0.0f, 0.8f}, {0.9778f, -0.2095f, 0}, {0, 0}, {0, 0, -1, 1}},
+      {{-1.2f, 0.0f, -1.2f}, {0.9778f, -0.2095f, 0}, {1, 0}, {0, 0, -1, 1}},
+      {{-0.9f, 1.4f, -1.2f}, {0.9778f, -0.2095f, 0}, {1, 1}, {0, 0, -1, 1}},
+      {{-0.9f, 1.4f, 0.8f}, {0.9778f, -0.2095f, 0}, {0, 1}, {0, 0, -1, 1}}};
+  b.addMesh(plate, {0, 1, 2, 0, 2, 3}, b.addMaterial(metal));
+  const std::string file = dir.file("casters.gltf");
+  ASSERT_TRUE(b.write(file));
+  Scene scene = load(sceneJson("", R"(, {"type": "mesh", "file": ")" + file + R"("})", -1), "gltf-casters");
+  scene.build();
+  EXPECT_EQ(scene.causticTracer().casters().size(), 2u);
+  expectAgree(std::move(scene), "glTF glass and polished metal");
+}
+
 // A spot light just above a mirror floor, pointing down at it, under a white diffuse ceiling: the
 // ceiling gets no direct light, only the caustic of the spot's mirror image, R I / d'^2 at distance
 // d' from it. No path tracer reaches that light; the light tracer must give it exactly. The pixel
