@@ -3,6 +3,7 @@
 #include "app/stop_signals.h"
 #include "checkpoint/checkpoint_file.h"
 #include "distributed/cluster.h"
+#include "io/filtered_texture.h"
 #include "io/image_io.h"
 #include "io/input_error.h"
 #include "io/scene_loader.h"
@@ -311,6 +312,8 @@ int runRender(RenderArgs a) {
       lastSave = Clock::now();
     };
   const RenderStats stats = render(scene, *integrator, options, film);
+  // A texture file that vanished mid-render made some lookups black: nothing is written.
+  if (const std::string failure = filteredTextureFailure(); !failure.empty()) throw InputError(failure);
   if (checkpointing) saveState(film, stats.passes);
   // Rank 0 gathers the other ranks' sums; only it writes images and reports.
   const bool interrupted = cluster.any(stats.interrupted);

@@ -13,24 +13,15 @@ import os
 import re
 import struct
 import subprocess
+import sys
 import tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from gltf_mesh import uv_sphere  # noqa: E402
 
 
 def sphere(rings, segments):
-    positions, normals, indices = [], [], []
-    for i in range(rings + 1):
-        theta = math.pi * i / rings
-        for j in range(segments + 1):
-            phi = 2.0 * math.pi * j / segments
-            n = (math.sin(theta) * math.cos(phi), math.cos(theta), -math.sin(theta) * math.sin(phi))
-            positions += [0.4 * c for c in n]
-            normals += n
-    for i in range(rings):
-        for j in range(segments):
-            a = i * (segments + 1) + j
-            b = a + segments + 1
-            indices += [a, b, a + 1, a + 1, b, b + 1]
-    return positions, normals, indices
+    return uv_sphere((0.0, 0.0, 0.0), 0.4, rings, segments)
 
 
 def write_gltf(path, nodes, rings=50, segments=100):

@@ -3,17 +3,62 @@
 #include "io/input_error.h"
 #include "materials/hit_memo.h"
 
+#include <atomic>
+#include <mutex>
+
 namespace ember {
+
+namespace {
+
+std::atomic<bool> anyFailure{false};
+std::mutex failureMutex;
+std::string firstFailure;
+
+void recordFailure(const std::string& name) {
+  if (anyFailure.exchange(true)) return;
+  std::lock_guard<std::mutex> lock(failureMutex);
+  firstFailure = name + ": texture lookups failed during the render (the file disappeared or changed?)";
+}
+
+ImagePlugin::Wrap pluginWrap(TextureWrap wrap) {
+  return wrap == TextureWrap::Clamp    ? ImagePlugin::Wrap::Clamp
+         : wrap == TextureWrap::Mirror ? ImagePlugin::Wrap::Mirror
+                                       : ImagePlugin::Wrap::Repeat;
+}
+
+}  // namespace
+
+std::string filteredTextureFailure() {
+  if (!anyFailure.load()) return "";
+  std::lock_guard<std::mutex> lock(failureMutex);
+  return firstFailure;
+}
+
+FilteredImageTexture::FilteredImageTexture(const ImagePlugin& plugin, const std::string& name,
+                                           const void* handle, const ImagePlugin::TextureFile& info,
+                                           TextureWrap wrap, const Color& scale)
+    : plugin_(plugin),
+      name_(name),
+      handle_(handle),
+      wrap_(pluginWrap(wrap)),
+      scale_(scale),
+      id_(newHitMemoOwner()) {
+  // The file's bounds, scaled (a negative scale swaps them); a blend of texels stays within them.
+  const Color lo = Color(info.min[0], info.min[1], info.min[2]) * scale;
+  const Color hi = Color(info.max[0], info.max[1], info.max[2]) * scale;
+  min_ = glm::min(lo, hi);
+  max_ = glm::max(lo, hi);
+  average_ = Color(info.mean[0], info.mean[1], info.mean[2]) * scale;
+  // Black is impossible only where some channel is positive everywhere and none is ever negative.
+  const bool positive = min_.x > 0.0f || min_.y > 0.0f || min_.z > 0.0f;
+  const bool negative = min_.x < 0.0f || min_.y < 0.0f || min_.z < 0.0f;
+  mayBeBlack_ = !positive || negative;
+}
 
 FilteredImageTexture::FilteredImageTexture(const ImagePlugin& plugin, const std::string& name, int width,
                                            int height, const std::vector<Color>& texels, TextureWrap wrap,
                                            const Color& scale)
-    : plugin_(plugin),
-      wrap_(wrap == TextureWrap::Clamp    ? ImagePlugin::Wrap::Clamp
-            : wrap == TextureWrap::Mirror ? ImagePlugin::Wrap::Mirror
-                                          : ImagePlugin::Wrap::Repeat),
-      scale_(scale),
-      id_(newHitMemoOwner()) {
+    : plugin_(plugin), name_(name), wrap_(pluginWrap(wrap)), scale_(scale), id_(newHitMemoOwner()) {
   rgb_.reserve(texels.size() * 3);
   // A filtered value is a weighted mean of texels: black only where some texel may be.
   TexelStatistics stats;
@@ -34,7 +79,10 @@ Color FilteredImageTexture::lookup(Vec2 uv, float width) const {
   float rgb[3] = {0.0f, 0.0f, 0.0f};
   const float w = std::isfinite(width) ? width : 0.0f;
   // A square footprint of side w in (s, t): dsdx = dtdy = w.
-  plugin_.lookup(handle_, wrap_, wrap_, uv.x, uv.y, w, 0.0f, 0.0f, w, rgb);
+  if (!plugin_.lookup(handle_, wrap_, wrap_, uv.x, uv.y, w, 0.0f, 0.0f, w, rgb)) {
+    recordFailure(name_);
+    return Color(0.0f);
+  }
   return scale_ * Color(rgb[0], rgb[1], rgb[2]);
 }
 

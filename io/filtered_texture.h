@@ -9,9 +9,15 @@
 #include "io/image_plugin.h"
 #include "materials/texture.h"
 
+#include <string>
 #include <vector>
 
 namespace ember {
+
+// The first failed lookup of any filtered texture in this process ("" if none), naming its file:
+// a texture file that disappears or changes while a render reads it from the texture cache. A
+// lookup that fails returns black; the render command then reports this and writes nothing.
+std::string filteredTextureFailure();
 
 class FilteredImageTexture final : public Texture {
  public:
@@ -19,6 +25,10 @@ class FilteredImageTexture final : public Texture {
   // cannot take the image.
   FilteredImageTexture(const ImagePlugin& plugin, const std::string& name, int width, int height,
                        const std::vector<Color>& texels, TextureWrap wrap, const Color& scale);
+  // A texture looked up straight from its file (ImagePlugin::addTextureFile: tiles read on demand,
+  // within the texture cache), already opened as `handle` with `info`'s bounds.
+  FilteredImageTexture(const ImagePlugin& plugin, const std::string& name, const void* handle,
+                       const ImagePlugin::TextureFile& info, TextureWrap wrap, const Color& scale);
   FilteredImageTexture(const FilteredImageTexture&) = delete;
   FilteredImageTexture& operator=(const FilteredImageTexture&) = delete;
 
@@ -35,7 +45,8 @@ class FilteredImageTexture final : public Texture {
   Color lookup(Vec2 uv, float width) const;
 
   const ImagePlugin& plugin_;
-  std::vector<float> rgb_;  // what the texture system reads, from memory
+  std::string name_;        // the file, for filteredTextureFailure
+  std::vector<float> rgb_;  // what the texture system reads, from memory (empty: from the file)
   const void* handle_;
   ImagePlugin::Wrap wrap_;
   Color scale_;

@@ -31,7 +31,7 @@ struct PluginPixels {
 
 class ImagePlugin {
  public:
-  static constexpr int kAbiVersion = 2;
+  static constexpr int kAbiVersion = 3;
   virtual ~ImagePlugin() = default;
   // The largest width x height read (the caller's limit), checked before pixels are allocated.
   // Returns "" on success, else the reason, without the file's name.
@@ -46,6 +46,23 @@ class ImagePlugin {
   // decoded (linear RGB floats, rows from the top; they must outlive the process's lookups) to the
   // texture system from memory, which makes its MIP levels on first use. nullptr on failure.
   virtual const void* addTexture(const float* rgb, int width, int height) const = 0;
+  // A texture looked up straight from its file: its tiles are read when a lookup needs them and
+  // kept in the texture system's cache (EMBER_TEXTURE_CACHE_MB, default 1024), its MIP levels the
+  // file's own (a .tx, a tiled MIP-mapped EXR) or made on first use. Level 0 is read once, row by
+  // row through the cache, for the bounds of its first three channels (a single channel counts
+  // for all three), so memory stays within the cache however large the file.
+  struct TextureFile {
+    int width = 0, height = 0, channels = 0;
+    bool floating = false;  // stored as half or float (else integers, normalised to [0, 1])
+    bool mipmapped = false;
+    float min[3] = {0, 0, 0}, max[3] = {0, 0, 0}, mean[3] = {0, 0, 0};
+  };
+  // Fills `info` and returns the handle, or nullptr and the reason (without the file's name) in
+  // `error`. Also nullptr, with `error` empty, for a file this cannot serve as stored: integers
+  // when `integersAreLinear` is false (they are sRGB-encoded, and the texture system would filter
+  // the encoded values), or two channels (grey and alpha).
+  virtual const void* addTextureFile(const std::string& path, bool integersAreLinear, TextureFile& info,
+                                     std::string& error) const = 0;
   enum class Wrap { Clamp, Repeat, Mirror };
   // The texture at (s, t) (s along the width, t down the rows, [0, 1] over the image), filtered
   // trilinearly over the footprint the derivatives span. False on a read error.

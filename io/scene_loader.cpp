@@ -181,6 +181,21 @@ class JsonSceneLoader {
         w->fail("unknown wrap '" + v + "'; valid: clamp, repeat, mirror");
     }
     const fs::path texPath = baseDir_ / file.string();
+    if (trilinear && encoding != ColorEncoding::Srgb) {
+      // Linear texels are filtered straight from the file, tile by tile within the texture cache
+      // (a .tx set larger than memory renders); sRGB ones are decoded first, below.
+      ImagePlugin::TextureFile info;
+      std::string error;
+      const void* handle =
+          plugin->addTextureFile(texPath.string(), encoding == ColorEncoding::Linear, info, error);
+      if (!error.empty()) file.fail(texPath.string() + ": " + error);
+      if (handle) {
+        scene_.sourceFiles.push_back(texPath.string());
+        scene_.filteredTextures = true;
+        return std::make_shared<FilteredImageTexture>(*plugin, texPath.string(), handle, info, wrap,
+                                                      n.color("scale", Color(1.0f)));
+      }
+    }
     TextureImage img;
     try {
       img = ember::readTexture(texPath.string(), encoding);

@@ -262,6 +262,7 @@ void WaveIntegrator::renderTile(const Scene& scene, const TileWork& work, Film& 
         PathState path = gather(s);
         SurfaceHit& hit = wave.hit[vertices];
         scene.surfaceHit(path.ray, raw, hit);
+        PathIntegrator::widenFootprint(scene, path, hit);
         const bool scatters = path_.arrive(scene, path, hit, stats);
         wave.radiance[size_t(owner)] = path.radiance;
         if (!scatters) return;

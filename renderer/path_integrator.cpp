@@ -79,6 +79,19 @@ void PathIntegrator::onMiss(const Scene& scene, PathState& path) const {
   }
 }
 
+void PathIntegrator::widenFootprint(const Scene& scene, const PathState& path, SurfaceHit& hit) {
+  if (!scene.filteredTextures || path.previousDelta || !(path.previousPdf > 0.0f) ||
+      !(hit.uvFootprint > 0.0f))
+    return;
+  const float camera = scene.camera().footprintAt(hit.p, hit.ng);
+  if (!(camera > 0.0f)) return;
+  const float spread = 2.0f / std::sqrt(kPi * path.previousPdf);
+  const float cosine = std::abs(glm::dot(path.ray.dir, hit.ng));
+  // The cone's width at the hit, seen obliquely as the camera's footprint is (1 / sqrt|cos|).
+  const float width = spread * hit.t / std::sqrt(std::max(cosine, 1e-3f));
+  hit.uvFootprint *= (camera + width) / camera;
+}
+
 bool PathIntegrator::onHit(const Scene& scene, PathState& path, const SurfaceHit& hit, Sampler& sampler,
                            PathStats& stats, ShadowRequest& shadow, bool& continues) const {
   continues = false;
@@ -167,6 +180,7 @@ Color PathIntegrator::Li(const Scene& scene, Ray ray, Sampler& sampler, PathStat
       onMiss(scene, path);
       break;
     }
+    widenFootprint(scene, path, hit);
     ShadowRequest shadow;
     bool continues;
     if (onHit(scene, path, hit, sampler, stats, shadow, continues) &&

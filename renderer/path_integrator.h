@@ -93,6 +93,15 @@ class PathIntegrator final : public Integrator {
   bool onHit(const Scene& scene, PathState& path, const SurfaceHit& hit, Sampler& sampler, PathStats& stats,
              ShadowRequest& shadow, bool& continues) const;
 
+  // Widens a filtered texture's footprint at `hit` (Scene::filteredTextures; otherwise nothing)
+  // by the spread of the BSDF lobe the path left its previous vertex through. A lobe of
+  // solid-angle density p covers about 1 / p steradians, a cone 2 / sqrt(pi p) radians wide,
+  // which has spread that much per unit of the segment's length when it reaches `hit` (a
+  // direction's spread sized from its pdf, as Suykens & Willems 2001's path differentials do for
+  // sampled directions). Camera rays and Dirac lobes add nothing to the camera's own footprint
+  // (Camera::footprintAt). So a footprint grows with distance and with roughness. The drivers call
+  // it on every hit before onHit or arrive.
+  static void widenFootprint(const Scene& scene, const PathState& path, SurfaceHit& hit);
   // onHit in its steps, for loops that sample the lights of many vertices together
   // (Light::sampleLanes): arrive, then pickLight, the light's sample, shadowFor, and scatter.
   // Emission and absorption on arrival; false if the path ends here without scattering.

@@ -12,10 +12,14 @@
 #include <OpenImageIO/texture.h>
 
 #include <atomic>
+#include <cmath>
+#include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <unordered_map>
+#include <vector>
 
 namespace ember {
 namespace {
@@ -134,7 +138,16 @@ oiio::TextureSystem& textureSystem() {
     // MIP levels made on first use for images that have none, kept in 64x64 tiles.
     t->attribute("automip", 1);
     t->attribute("autotile", 64);
-    t->attribute("max_memory_MB", 1024.0f);
+    // The cache's size: EMBER_TEXTURE_CACHE_MB, else 1 GiB. Textures looked up from their files
+    // (addTextureFile) keep only the tiles that fit.
+    float megabytes = 1024.0f;
+    if (const char* env = std::getenv("EMBER_TEXTURE_CACHE_MB")) {
+      const float v = std::strtof(env, nullptr);
+      if (v > 0.0f && std::isfinite(v)) megabytes = v;
+    }
+    t->attribute("max_memory_MB", megabytes);
+    // A grey file's one channel answers for all three.
+    t->attribute("gray_to_rgb", 1);
     return t;
   }();
   return *ts;
@@ -216,6 +229,75 @@ class OiioImagePlugin final : public ImagePlugin {
     const oiio::ustring key(name);
     if (!ts.imagecache()->add_file(key, &createMemoryInput)) return nullptr;
     return ts.get_texture_handle(key);
+  }
+
+  const void* addTextureFile(const std::string& path, bool integersAreLinear, TextureFile& info,
+                             std::string& error) const override {
+    oiio::TextureSystem& ts = textureSystem();
+    oiio::ImageCache& cache = *ts.imagecache();
+    const oiio::ustring name(path);
+    oiio::ImageSpec spec;
+    if (!cache.get_imagespec(name, spec, 0, 0)) {
+      error = cache.geterror();
+      if (error.empty()) error = "cannot open it";
+      return nullptr;
+    }
+    // Only the formats read() reads (the cache would otherwise open videos and camera raws too).
+    oiio::ustring format;
+    cache.get_image_info(name, 0, 0, oiio::ustring("fileformat"), oiio::TypeString, &format);
+    bool known = false;
+    for (const char* f : kImageFormats) known = known || format == f;
+    if (!known) {
+      error = "not an image in a format Ember reads through OpenImageIO";
+      return nullptr;
+    }
+    info.width = spec.width;
+    info.height = spec.height;
+    info.channels = spec.nchannels;
+    const auto base = oiio::TypeDesc::BASETYPE(spec.format.basetype);
+    info.floating =
+        base == oiio::TypeDesc::HALF || base == oiio::TypeDesc::FLOAT || base == oiio::TypeDesc::DOUBLE;
+    int levels = 1;
+    cache.get_image_info(name, 0, 0, oiio::ustring("miplevels"), oiio::TypeInt, &levels);
+    info.mipmapped = levels > 1;
+    if ((!info.floating && !integersAreLinear) || info.channels == 2) return nullptr;
+    if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1) {
+      error = "not a 2D image";
+      return nullptr;
+    }
+    // The bounds, row by row through the cache (its tiles come and go; memory stays bounded).
+    const int nc = std::min(spec.nchannels, 3);
+    std::vector<float> row(size_t(spec.width) * size_t(nc));
+    double sum[3] = {0.0, 0.0, 0.0};
+    float lo[3], hi[3];
+    for (int c = 0; c < 3; ++c) {
+      lo[c] = std::numeric_limits<float>::infinity();
+      hi[c] = -std::numeric_limits<float>::infinity();
+    }
+    for (int y = spec.y; y < spec.y + spec.height; ++y) {
+      if (!cache.get_pixels(name, 0, 0, spec.x, spec.x + spec.width, y, y + 1, spec.z, spec.z + 1, 0, nc,
+                            oiio::TypeFloat, row.data())) {
+        error = cache.geterror();
+        if (error.empty()) error = "cannot read row " + std::to_string(y - spec.y);
+        return nullptr;
+      }
+      for (int x = 0; x < spec.width; ++x)
+        for (int c = 0; c < 3; ++c) {
+          const float v = row[size_t(x) * size_t(nc) + size_t(std::min(c, nc - 1))];
+          lo[c] = std::min(lo[c], v);
+          hi[c] = std::max(hi[c], v);
+          sum[c] += double(v);
+        }
+    }
+    const double texels = double(spec.width) * double(spec.height);
+    for (int c = 0; c < 3; ++c) {
+      info.min[c] = lo[c];
+      info.max[c] = hi[c];
+      info.mean[c] = float(sum[c] / texels);
+    }
+    auto* handle = ts.get_texture_handle(name);
+    if (!handle) error = "the texture system cannot take it";
+    return handle;
   }
 
   bool lookup(const void* texture, Wrap wrapS, Wrap wrapT, float s, float t, float dsdx, float dtdx,
