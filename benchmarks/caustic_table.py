@@ -159,7 +159,7 @@ def main():
                                   caustics, seconds, 1 + k, a.width, a.height)
                 cells.append((spp, relmse(img, ref)))
             (ts, te), (ps, pe) = cells
-            print(f"| {light} | {seconds:g} | {ts} | {te:.5f} | {ps} | {pe:.5f} | {pe / te:.1f} |", flush=True)
+            print(f"| {light} | {seconds:g} | {ts} | {te:.3g} | {ps} | {pe:.3g} | {pe / te:.1f} |", flush=True)
 
 
 if __name__ == "__main__":

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""A texture set larger than the texture cache: N float .tx files (tiled, MIP-mapped, made by
+"""A texture set larger than the texture cache: N float .tx files (RGB, tiled, MIP-mapped, made by
 OpenImageIO's maketx through oiiotool) on N quads seen by the camera, rendered with
 "filter": "trilinear" (looked up straight from the files, tile by tile, within
 EMBER_TEXTURE_CACHE_MB) and with "filter": "bilinear" (every texel decoded into memory first).
@@ -24,7 +24,7 @@ def make_textures(out, count, size):
         path = os.path.join(out, f"noise-{size}-{k}.tx")
         if not os.path.exists(path):
             subprocess.run(["oiiotool", "--pattern", f"noise:type=uniform:min=0.05:max=0.95:seed={k + 1}",
-                            f"{size}x{size}", "3", "-d", "half", "--otex", path], check=True)
+                            f"{size}x{size}", "3", "--otex", path], check=True)
         paths.append(path)
     return paths
 
@@ -70,8 +70,8 @@ def main():
     os.makedirs(a.out, exist_ok=True)
     paths = make_textures(a.out, a.count, a.size)
     on_disk = sum(os.path.getsize(p) for p in paths) / 2**20
-    texel_mb = a.count * a.size * a.size * 3 * 2 * 4 / 3 / 2**20  # half RGB, with the MIP levels
-    print(f"{a.count} textures of {a.size}x{a.size} half RGB: {texel_mb:.0f} MB of texels with their MIP "
+    texel_mb = a.count * a.size * a.size * 3 * 4 * 4 / 3 / 2**20  # float RGB, with the MIP levels
+    print(f"{a.count} textures of {a.size}x{a.size} float RGB: {texel_mb:.0f} MB of texels with their MIP "
           f"levels, {on_disk:.0f} MB on disk\n")
     print("| filter | texture cache | peak resident MB | load+build s | render s |")
     print("|---|---|---|---|---|")

@@ -300,6 +300,26 @@ TEST(FilteredTexture, ATextureThatDisappearsBetweenRendersIsAnErrorNamingIt) {
   EXPECT_NE(again.exitCode, 0);
   EXPECT_NE(again.output.find("wood.tx"), std::string::npos) << again.output;
   EXPECT_FALSE(std::filesystem::exists(dir.file("b.exr")));
+  // A truncated file: an error naming it at load.
+  ASSERT_EQ(plugin->write(dir.file("cut.tx"), floatPixels(randomTexels(64, 64, 3), 64, 64)), "");
+  std::filesystem::resize_file(dir.file("cut.tx"), std::filesystem::file_size(dir.file("cut.tx")) / 10);
+  try {
+    loadScene(dir.write("cut.json", texturedQuad("cut.tx", "trilinear")));
+    ADD_FAILURE() << "a truncated texture loaded";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cut.tx"), std::string::npos) << e.what();
+  }
+  // Level 0 whole but the coarser MIP levels cut off: the load (which reads level 0) succeeds, the
+  // render's lookups fail, and the render command says so and writes nothing.
+  ASSERT_EQ(plugin->write(dir.file("tail.tx"), floatPixels(randomTexels(256, 256, 4), 256, 256)), "");
+  std::filesystem::resize_file(dir.file("tail.tx"),
+                               std::filesystem::file_size(dir.file("tail.tx")) * 82 / 100);
+  const std::string tail = dir.write("tail.json", texturedQuad("tail.tx", "trilinear", 16, 12));
+  const test::CliResult cut =
+      test::runEmber("render '" + tail + "' -o '" + dir.file("c.exr") + "' --spp 4 -q");
+  EXPECT_NE(cut.exitCode, 0);
+  EXPECT_NE(cut.output.find("tail.tx: texture lookups failed"), std::string::npos) << cut.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("c.exr")));
 }
 
 }  // namespace
