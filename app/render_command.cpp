@@ -43,6 +43,7 @@ struct RenderArgs {
   std::string env;
   std::optional<float> envStrength;
   std::string variant;
+  std::string textureFilter;
   bool quiet = false;
   std::string checkpoint, resume, time;
   double checkpointEvery = 60.0;
@@ -145,11 +146,12 @@ struct RenderSetup {
   std::optional<Checkpoint> resumed;
 };
 
-Scene loadConfigured(const std::string& path, int camera, const std::string& variant,
-                     const std::string& env) {
+Scene loadConfigured(const std::string& path, int camera, const std::string& variant, const std::string& env,
+                     const std::string& textureFilter) {
   LoadOptions loadOptions;
   loadOptions.camera = camera;
   loadOptions.variant = variant;
+  loadOptions.trilinearTextures = textureFilter == "trilinear";
   loadOptions.environmentGiven = !env.empty();
   Scene scene = loadScene(path, loadOptions);
   if (!env.empty()) applyEnvironment(env, scene);
@@ -172,6 +174,7 @@ RenderSetup setUp(RenderArgs& a) {
                                                    {!a.env.empty(), "--env"},
                                                    {a.envStrength.has_value(), "--env-strength"},
                                                    {!a.variant.empty(), "--variant"},
+                                                   {!a.textureFilter.empty(), "--texture-filter"},
                                                    {a.camera >= 0, "--camera"},
                                                    {a.firstSample != 0, "--first-sample"},
                                                    {a.passSpp.has_value(), "--pass-spp"}})
@@ -188,7 +191,7 @@ RenderSetup setUp(RenderArgs& a) {
                        EMBER_VERSION +
                        ", whose samples may differ: resume it with the version that wrote it");
     const RenderIdentity& id = c.identity;
-    setup.scene = loadConfigured(id.scene, id.camera, id.variant, id.env);
+    setup.scene = loadConfigured(id.scene, id.camera, id.variant, id.env, id.textureFilter);
     RenderSettings& s = setup.scene.settings;
     s.width = id.width;
     s.height = id.height;
@@ -210,6 +213,7 @@ RenderSetup setUp(RenderArgs& a) {
                        std::to_string(held) + ", not a multiple of the pass size " +
                        std::to_string(c.passSpp) + "), so it cannot be extended");
     setup.identity = identityOf(setup.scene, id.scene, id.camera, id.variant, id.env);
+    setup.identity.textureFilter = id.textureFilter;
     if (const std::string diff = id.differenceFrom(setup.identity); !diff.empty())
       throw InputError(a.resume + ": the checkpoint no longer matches its scene: " + diff);
     if (a.output.empty()) a.output = c.output;
@@ -225,7 +229,8 @@ RenderSetup setUp(RenderArgs& a) {
       throw InputError("--env-strength scales the --env light; give --env too (e.g. --env white)");
     a.env += kStrengthTag + std::to_string(*a.envStrength);
   }
-  setup.scene = loadConfigured(a.scene, a.camera, a.variant, a.env);
+  if (a.textureFilter == "bilinear") a.textureFilter.clear();  // the samplers' own: the default
+  setup.scene = loadConfigured(a.scene, a.camera, a.variant, a.env, a.textureFilter);
   RenderSettings& s = setup.scene.settings;
   if (a.spp) s.spp = *a.spp;
   if (a.seed) s.seed = *a.seed;
@@ -237,6 +242,7 @@ RenderSetup setUp(RenderArgs& a) {
   if (!a.strategy.empty()) s.strategy = *parseStrategy(a.strategy);  // CLI11 checked the name
   if (!a.caustics.empty()) s.traceCaustics = a.caustics == "trace";
   setup.identity = identityOf(setup.scene, a.scene, a.camera, a.variant, a.env);
+  setup.identity.textureFilter = a.textureFilter;
   setup.firstSample = a.firstSample;
   setup.passSpp = a.passSpp.value_or(4);
   return setup;
@@ -432,6 +438,11 @@ Runner addRenderCommand(CLI::App& app) {
                   "equirectangular EXR/HDR map; replaces the scene's or the default one");
   cmd->add_option("--env-strength", args->envStrength, "Multiplies the --env light (default 1)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--texture-filter", args->textureFilter,
+                  "glTF files: how their images are filtered: bilinear (the default; nearest where a sampler "
+                  "asks) or trilinear (MIP-mapped over each hit's pixel footprint through OpenImageIO: less "
+                  "aliasing at low sample counts, a little blur)")
+      ->check(CLI::IsMember({"bilinear", "trilinear"}));
   cmd->add_option("--variant", args->variant,
                   "glTF files: render the materials of this KHR_materials_variants variant (`ember info` "
                   "lists them)");

@@ -61,6 +61,7 @@ uint64_t RenderIdentity::hash() const {
   feedValue(s, camera);
   feed(s, env);
   if (!variant.empty()) feed(s, variant);  // absent from checkpoints written before variants
+  if (!textureFilter.empty()) feed(s, "texture_filter=" + textureFilter);  // likewise
   return XXH3_64bits_digest(s);
 }
 
@@ -73,10 +74,13 @@ std::string hexHash(uint64_t h) {
 nlohmann::json RenderIdentity::toJson() const {
   nlohmann::json fs = nlohmann::json::array();
   for (const File& f : files) fs.push_back({{"path", f.path}, {"xxh3", hexHash(f.hash)}});
-  return {{"scene", scene},        {"files", fs},          {"width", width},   {"height", height},
-          {"max_depth", maxDepth}, {"rr_depth", rrDepth},  {"seed", seed},     {"sampler", sampler},
-          {"strategy", strategy},  {"caustics", caustics}, {"camera", camera}, {"env", env},
-          {"variant", variant}};
+  return {{"scene", scene},        {"files", fs},
+          {"width", width},        {"height", height},
+          {"max_depth", maxDepth}, {"rr_depth", rrDepth},
+          {"seed", seed},          {"sampler", sampler},
+          {"strategy", strategy},  {"caustics", caustics},
+          {"camera", camera},      {"env", env},
+          {"variant", variant},    {"texture_filter", textureFilter}};
 }
 
 RenderIdentity RenderIdentity::fromJson(const nlohmann::json& j, const std::string& origin) {
@@ -99,6 +103,9 @@ RenderIdentity RenderIdentity::fromJson(const nlohmann::json& j, const std::stri
     id.camera = j.at("camera").get<int>();
     id.env = j.at("env").get<std::string>();
     id.variant = j.value("variant", std::string());
+    id.textureFilter = j.value("texture_filter", std::string());
+    if (!id.textureFilter.empty() && id.textureFilter != "trilinear")
+      throw InputError(origin + ": texture filter '" + id.textureFilter + "' is not trilinear");
     if (id.width <= 0 || id.height <= 0 || id.width > 16384 || id.height > 16384)
       throw InputError(origin + ": image size " + std::to_string(id.width) + "x" + std::to_string(id.height) +
                        " is out of range");
@@ -132,6 +139,8 @@ std::string RenderIdentity::differenceFrom(const RenderIdentity& now) const {
   if (camera != now.camera) return differs("the camera", camera, now.camera);
   if (env != now.env) return differs("the environment", "'" + env + "'", "'" + now.env + "'");
   if (variant != now.variant) return differs("the variant", "'" + variant + "'", "'" + now.variant + "'");
+  if (textureFilter != now.textureFilter)
+    return differs("the texture filter", "'" + textureFilter + "'", "'" + now.textureFilter + "'");
   return "";
 }
 

@@ -28,6 +28,7 @@ struct RenderIdentity {
   int camera = -1;                 // --camera
   std::string env;                 // --env, verbatim (its file, if any, is among `files`)
   std::string variant;             // --variant (KHR_materials_variants); empty: the default materials
+  std::string textureFilter;       // --texture-filter trilinear; empty: the glTF samplers' own
 
   // XXH3-64 over the files' hashes and every setting above: equal iff the renders are the same.
   uint64_t hash() const;

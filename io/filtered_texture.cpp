@@ -40,7 +40,8 @@ FilteredImageTexture::FilteredImageTexture(const ImagePlugin& plugin, const std:
     : plugin_(plugin),
       name_(name),
       handle_(handle),
-      wrap_(pluginWrap(wrap)),
+      wrapS_(pluginWrap(wrap)),
+      wrapT_(wrapS_),
       scale_(scale),
       id_(newHitMemoOwner()) {
   // The file's bounds, scaled (a negative scale swaps them); a blend of texels stays within them.
@@ -56,9 +57,14 @@ FilteredImageTexture::FilteredImageTexture(const ImagePlugin& plugin, const std:
 }
 
 FilteredImageTexture::FilteredImageTexture(const ImagePlugin& plugin, const std::string& name, int width,
-                                           int height, const std::vector<Color>& texels, TextureWrap wrap,
-                                           const Color& scale)
-    : plugin_(plugin), name_(name), wrap_(pluginWrap(wrap)), scale_(scale), id_(newHitMemoOwner()) {
+                                           int height, const std::vector<Color>& texels, TextureWrap wrapS,
+                                           TextureWrap wrapT, const Color& scale)
+    : plugin_(plugin),
+      name_(name),
+      wrapS_(pluginWrap(wrapS)),
+      wrapT_(pluginWrap(wrapT)),
+      scale_(scale),
+      id_(newHitMemoOwner()) {
   rgb_.reserve(texels.size() * 3);
   // A filtered value is a weighted mean of texels: black only where some texel may be.
   TexelStatistics stats;
@@ -79,7 +85,7 @@ Color FilteredImageTexture::lookup(Vec2 uv, float width) const {
   float rgb[3] = {0.0f, 0.0f, 0.0f};
   const float w = std::isfinite(width) ? width : 0.0f;
   // A square footprint of side w in (s, t): dsdx = dtdy = w.
-  if (!plugin_.lookup(handle_, wrap_, wrap_, uv.x, uv.y, w, 0.0f, 0.0f, w, rgb)) {
+  if (!plugin_.lookup(handle_, wrapS_, wrapT_, uv.x, uv.y, w, 0.0f, 0.0f, w, rgb)) {
     recordFailure(name_);
     return Color(0.0f);
   }

@@ -24,7 +24,12 @@ class FilteredImageTexture final : public Texture {
   // `texels`: linear, rows from the top. Throws InputError(`name`: ...) if the texture system
   // cannot take the image.
   FilteredImageTexture(const ImagePlugin& plugin, const std::string& name, int width, int height,
-                       const std::vector<Color>& texels, TextureWrap wrap, const Color& scale);
+                       const std::vector<Color>& texels, TextureWrap wrap, const Color& scale)
+      : FilteredImageTexture(plugin, name, width, height, texels, wrap, wrap, scale) {}
+  // wrapS along the width, wrapT along the rows (glTF samplers).
+  FilteredImageTexture(const ImagePlugin& plugin, const std::string& name, int width, int height,
+                       const std::vector<Color>& texels, TextureWrap wrapS, TextureWrap wrapT,
+                       const Color& scale);
   // A texture looked up straight from its file (ImagePlugin::addTextureFile: tiles read on demand,
   // within the texture cache), already opened as `handle` with `info`'s bounds.
   FilteredImageTexture(const ImagePlugin& plugin, const std::string& name, const void* handle,
@@ -36,6 +41,7 @@ class FilteredImageTexture final : public Texture {
   Color eval(Vec2 uv) const override { return lookup(uv, 0.0f); }
   Color evalAt(const SurfaceHit& hit) const override;
   Color evalFresh(const SurfaceHit& hit) const override { return lookup(hit.uv, hit.uvFootprint); }
+  Color evalFootprint(Vec2 uv, float width) const override { return lookup(uv, width); }
   Color maxValue() const override { return max_; }
   Color minValue() const override { return min_; }
   Color average() const override { return average_; }
@@ -48,7 +54,7 @@ class FilteredImageTexture final : public Texture {
   std::string name_;        // the file, for filteredTextureFailure
   std::vector<float> rgb_;  // what the texture system reads, from memory (empty: from the file)
   const void* handle_;
-  ImagePlugin::Wrap wrap_;
+  ImagePlugin::Wrap wrapS_, wrapT_;
   Color scale_;
   Color max_{0.0f}, min_{0.0f}, average_{0.0f};
   bool mayBeBlack_ = false;

@@ -5,6 +5,7 @@
 #include "accel/sphere.h"
 #include "io/gltf_compression.h"
 #include "io/gltf_materials.h"
+#include "io/image_plugin.h"
 #include "io/input_error.h"
 
 #include <tiny_gltf.h>
@@ -32,7 +33,15 @@ constexpr int kModePoints = 0, kModeLines = 1, kModeLineLoop = 2, kModeLineStrip
 class GltfImporter {
  public:
   GltfImporter(const std::string& path, Scene& scene, const GltfImportOptions& options)
-      : path_(path), scene_(scene), options_(options), materials_(model_, path, scene) {}
+      : path_(path),
+        scene_(scene),
+        options_(options),
+        materials_(model_, path, scene, options.trilinearTextures ? imagePlugin() : nullptr) {
+    if (options.trilinearTextures && !imagePlugin())
+      throw InputError(
+          path + ": trilinear texture filtering needs the OpenImageIO plugin, which could not be loaded: " +
+          imagePluginError());
+  }
 
   GltfImport run() {
     load();

@@ -22,6 +22,10 @@ struct GltfImportOptions {
   // KHR_materials_variants: the variant whose materials primitives take where they map one;
   // empty: every primitive's default material.
   std::string variant;
+  // The images' filter: trilinear (MIP-mapped over each hit's footprint through OpenImageIO's
+  // TextureSystem, io/filtered_texture.h; the plugin must be loaded) instead of the samplers'
+  // bilinear. Samplers asking for nearest keep it.
+  bool trilinearTextures = false;
 };
 
 struct GltfImport {

@@ -1,5 +1,6 @@
 #include "io/gltf_materials.h"
 
+#include "io/filtered_texture.h"
 #include "io/input_error.h"
 #include "materials/gltf_pbr.h"
 #include "materials/lambertian.h"
@@ -344,11 +345,25 @@ std::shared_ptr<const Texture> GltfMaterialReader::texture(int index, int texCoo
     wrapT = wrapMode(s.wrapT);
     if (s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST) filter = TextureFilter::Nearest;
   }
-  std::shared_ptr<const Texture> out =
-      img->bytes ? std::make_shared<ImageTexture>(img->width, img->height, byteChannels(*img, channels),
-                                                  filter, wrapS, wrapT, scale)
-                 : std::make_shared<ImageTexture>(img->width, img->height, floatTexels(*img, channels),
-                                                  filter, wrapS, wrapT, scale);
+  std::shared_ptr<const Texture> out;
+  if (filtering_ && filter != TextureFilter::Nearest) {
+    const std::vector<Color> texels =
+        img->bytes ? byteTexels(*img, byteChannels(*img, channels)) : floatTexels(*img, channels);
+    try {
+      out = std::make_shared<FilteredImageTexture>(*filtering_,
+                                                   path_ + ": images[" + std::to_string(tex.source) + "]",
+                                                   img->width, img->height, texels, wrapS, wrapT, scale);
+    } catch (const InputError& e) {
+      fail(where, e.what());
+    }
+    scene_.filteredTextures = true;
+  } else if (img->bytes) {
+    out = std::make_shared<ImageTexture>(img->width, img->height, byteChannels(*img, channels), filter, wrapS,
+                                         wrapT, scale);
+  } else {
+    out = std::make_shared<ImageTexture>(img->width, img->height, floatTexels(*img, channels), filter, wrapS,
+                                         wrapT, scale);
+  }
 
   if (const tinygltf::Value* t = extension(extensions, "KHR_texture_transform")) {
     const std::string w = where + ".extensions.KHR_texture_transform";
@@ -407,6 +422,16 @@ std::vector<Color> GltfMaterialReader::floatTexels(const Decoded& img, Channels 
         break;
     }
   }
+  return texels;
+}
+
+std::vector<Color> GltfMaterialReader::byteTexels(const Decoded& img, const ImageTexture::ByteChannels& in) {
+  const size_t n = size_t(img.width) * size_t(img.height);
+  std::vector<Color> texels(n);
+  for (size_t i = 0; i < n; ++i)
+    for (size_t c = 0; c < 3; ++c)
+      texels[i][int(c)] =
+          in.tables[c][in.source[c] < 0 ? 0 : in.bytes[i * size_t(in.stride) + size_t(in.source[c])]];
   return texels;
 }
 

@@ -4,6 +4,7 @@
 // (thickness) and KHR_texture_transform are read. Each glTF material is converted once.
 #pragma once
 
+#include "io/image_plugin.h"
 #include "materials/surface_maps.h"
 #include "renderer/scene.h"
 
@@ -29,8 +30,11 @@ struct GltfSurface {
 
 class GltfMaterialReader {
  public:
-  GltfMaterialReader(const tinygltf::Model& model, const std::string& path, Scene& scene)
-      : model_(model), path_(path), scene_(scene) {}
+  // `filtering`: images become trilinear textures through this plugin (GltfImportOptions);
+  // null: the samplers' filters.
+  GltfMaterialReader(const tinygltf::Model& model, const std::string& path, Scene& scene,
+                     const ImagePlugin* filtering = nullptr)
+      : model_(model), path_(path), scene_(scene), filtering_(filtering) {}
 
   // The surface for material index `index` (-1 or out of range: the spec's default material).
   // `vertexColors`: the primitive has COLOR_0, which multiplies the base colour and its alpha;
@@ -59,12 +63,15 @@ class GltfMaterialReader {
   // the tables and byte positions that give the same values from an 8-bit image's bytes.
   static std::vector<Color> floatTexels(const Decoded& img, Channels channels);
   static ImageTexture::ByteChannels byteChannels(const Decoded& img, Channels channels);
+  // The floats those tables give, texel by texel (for a filtered texture, which keeps floats).
+  static std::vector<Color> byteTexels(const Decoded& img, const ImageTexture::ByteChannels& in);
   [[noreturn]] void fail(const std::string& where, const std::string& what) const;
   void warn(const std::string& where, const std::string& what) const;
 
   const tinygltf::Model& model_;
   std::string path_;
   Scene& scene_;
+  const ImagePlugin* filtering_;
   std::map<std::pair<int, bool>, GltfSurface> surfaces_;
   GltfSurface* converting_ = nullptr;  // the surface convert() is filling: texture() notes its sets
   std::map<int, Decoded> images_;

@@ -366,7 +366,7 @@ class JsonSceneLoader {
         s.at("vertices").fail("the four vertices of a quad must lie in one plane");
       shape = std::make_unique<Quad>(v, uv);
     } else if (type == "mesh") {
-      common({"file", "transform", "materials", "variant"});
+      common({"file", "transform", "materials", "variant", "texture_filter"});
       if (s.has("flip_normals")) s.at("flip_normals").fail("not supported for meshes");
       readMesh(s, emission);
       return;
@@ -448,6 +448,12 @@ class JsonSceneLoader {
         options.materialsByName[it.key()] = materialNamed(byName->at(it.key()));
     }
     if (auto variant = s.find("variant")) options.variant = variant->string();
+    if (auto filter = s.find("texture_filter")) {
+      const std::string v = filter->string();
+      if (v != "bilinear" && v != "trilinear")
+        filter->fail("unknown texture filter '" + v + "'; valid: bilinear, trilinear");
+      options.trilinearTextures = v == "trilinear";
+    }
     const size_t first = scene_.meshes.size();
     try {
       importGltf(meshPath.string(), scene_, options);
@@ -524,6 +530,7 @@ Scene loadGltfScene(const std::string& path, const LoadOptions& load) {
   GltfImportOptions options;
   options.camera = load.camera;
   options.variant = load.variant;
+  options.trilinearTextures = load.trilinearTextures;
   const GltfImport imported = importGltf(path, scene, options);
   if (imported.triangles + imported.points + imported.segments == 0)
     throw InputError(path + ": the scene contains nothing to render");

@@ -11,8 +11,9 @@ namespace ember {
 
 struct LoadOptions {
   int camera = -1;  // glTF files: index into the file's cameras (-1: the first one placed by a node)
-  bool environmentGiven = false;  // the caller sets an environment (--env): no default sky for glTF
-  std::string variant;            // glTF files: a KHR_materials_variants variant (--variant)
+  bool environmentGiven = false;   // the caller sets an environment (--env): no default sky for glTF
+  std::string variant;             // glTF files: a KHR_materials_variants variant (--variant)
+  bool trilinearTextures = false;  // glTF files: filter their images trilinearly (--texture-filter)
 };
 
 Scene loadScene(const std::string& path, const LoadOptions& options = {});

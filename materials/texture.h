@@ -24,7 +24,12 @@ class Texture {
   virtual Color evalAt(const SurfaceHit& hit) const { return eval(hit.uv); }
   // evalAt without the per-hit memo, for a caller that remembers the whole vertex's inputs itself
   // (GltfPbrMaterial::fetchFor): a second memo under it would only cost its check and store.
-  virtual Color evalFresh(const SurfaceHit& hit) const { return eval(hit.texCoord(texCoordSet())); }
+  // Filtered over the hit's footprint where the texture filters (SurfaceHit::uvFootprint).
+  virtual Color evalFresh(const SurfaceHit& hit) const {
+    return evalFootprint(hit.texCoord(texCoordSet()), hit.uvFootprint);
+  }
+  // The texture over a footprint `width` wide in UV units; textures that do not filter ignore it.
+  virtual Color evalFootprint(Vec2 uv, float /*width*/) const { return eval(uv); }
   // Largest value the texture can return per channel (used for sampling decisions).
   virtual Color maxValue() const = 0;
   // Smallest value it can return per channel (whether a roughness map reaches 0 somewhere).
@@ -45,6 +50,7 @@ class ConstantTexture final : public Texture {
   explicit ConstantTexture(const Color& c) : value_(c) {}
   Color eval(Vec2) const override { return value_; }
   Color evalAt(const SurfaceHit&) const override { return value_; }
+  Color evalFresh(const SurfaceHit&) const override { return value_; }
   Color maxValue() const override { return value_; }
   Color minValue() const override { return value_; }
   Color average() const override { return value_; }
@@ -105,6 +111,9 @@ class ImageTexture final : public Texture {
   ImageTexture& operator=(const ImageTexture&) = delete;
   Color eval(Vec2 uv) const override;
   Color evalAt(const SurfaceHit& hit) const override;
+  // Its coordinates are always set 0 (TexCoordSetTexture wraps it for the others), and it does
+  // not filter: the lookup at hit.uv, without evalFootprint's call.
+  Color evalFresh(const SurfaceHit& hit) const override { return eval(hit.uv); }
   Color maxValue() const override { return max_; }
   Color minValue() const override { return min_; }
   Color average() const override { return average_; }
@@ -156,9 +165,12 @@ class UvTransformTexture final : public Texture {
       : inner_(std::move(inner)),
         offset_(offset),
         row0_(std::cos(rotation) * scale.x, std::sin(rotation) * scale.y),
-        row1_(-std::sin(rotation) * scale.x, std::cos(rotation) * scale.y) {}
-  Color eval(Vec2 uv) const override {
-    return inner_->eval(Vec2(glm::dot(row0_, uv), glm::dot(row1_, uv)) + offset_);
+        row1_(-std::sin(rotation) * scale.x, std::cos(rotation) * scale.y),
+        widthScale_(std::sqrt(std::abs(scale.x * scale.y))) {}
+  Color eval(Vec2 uv) const override { return inner_->eval(map(uv)); }
+  // A footprint scales with the map's mean stretch, sqrt|det|.
+  Color evalFootprint(Vec2 uv, float width) const override {
+    return inner_->evalFootprint(map(uv), width * widthScale_);
   }
   Color maxValue() const override { return inner_->maxValue(); }
   Color minValue() const override { return inner_->minValue(); }
@@ -166,8 +178,11 @@ class UvTransformTexture final : public Texture {
   bool mayBeBlack() const override { return inner_->mayBeBlack(); }
 
  private:
+  Vec2 map(Vec2 uv) const { return Vec2(glm::dot(row0_, uv), glm::dot(row1_, uv)) + offset_; }
+
   std::shared_ptr<const Texture> inner_;
   Vec2 offset_, row0_, row1_;
+  float widthScale_;
 };
 
 // A texture read with texture coordinate set `set` (glTF's TEXCOORD_n, n > 0): evalAt looks the
@@ -177,6 +192,8 @@ class TexCoordSetTexture final : public Texture {
   TexCoordSetTexture(std::shared_ptr<const Texture> inner, int set) : inner_(std::move(inner)), set_(set) {}
   Color eval(Vec2 uv) const override { return inner_->eval(uv); }
   Color evalAt(const SurfaceHit& hit) const override { return inner_->eval(hit.texCoord(set_)); }
+  // The footprint is set 0's (Scene::surfaceHit): an approximation for the other sets.
+  Color evalFootprint(Vec2 uv, float width) const override { return inner_->evalFootprint(uv, width); }
   Color maxValue() const override { return inner_->maxValue(); }
   Color minValue() const override { return inner_->minValue(); }
   Color average() const override { return inner_->average(); }
@@ -201,6 +218,7 @@ class VertexColorTexture final : public Texture {
   Color evalAt(const SurfaceHit& hit) const override {
     return inner_->evalAt(hit) * Color(hit.vertexColor());
   }
+  Color evalFootprint(Vec2 uv, float width) const override { return inner_->evalFootprint(uv, width); }
   Color maxValue() const override { return inner_->maxValue(); }
   Color minValue() const override { return glm::min(inner_->minValue(), Color(0.0f)); }
   Color average() const override { return inner_->average(); }

@@ -79,10 +79,8 @@ void PathIntegrator::onMiss(const Scene& scene, PathState& path) const {
   }
 }
 
-void PathIntegrator::widenFootprint(const Scene& scene, const PathState& path, SurfaceHit& hit) {
-  if (!scene.filteredTextures || path.previousDelta || !(path.previousPdf > 0.0f) ||
-      !(hit.uvFootprint > 0.0f))
-    return;
+void PathIntegrator::widenFilteredFootprint(const Scene& scene, const PathState& path, SurfaceHit& hit) {
+  if (path.previousDelta || !(path.previousPdf > 0.0f) || !(hit.uvFootprint > 0.0f)) return;
   const float camera = scene.camera().footprintAt(hit.p, hit.ng);
   if (!(camera > 0.0f)) return;
   const float spread = 2.0f / std::sqrt(kPi * path.previousPdf);

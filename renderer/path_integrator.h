@@ -101,7 +101,9 @@ class PathIntegrator final : public Integrator {
   // sampled directions). Camera rays and Dirac lobes add nothing to the camera's own footprint
   // (Camera::footprintAt). So a footprint grows with distance and with roughness. The drivers call
   // it on every hit before onHit or arrive.
-  static void widenFootprint(const Scene& scene, const PathState& path, SurfaceHit& hit);
+  static void widenFootprint(const Scene& scene, const PathState& path, SurfaceHit& hit) {
+    if (scene.filteredTextures) widenFilteredFootprint(scene, path, hit);
+  }
   // onHit in its steps, for loops that sample the lights of many vertices together
   // (Light::sampleLanes): arrive, then pickLight, the light's sample, shadowFor, and scatter.
   // Emission and absorption on arrival; false if the path ends here without scattering.
@@ -134,6 +136,8 @@ class PathIntegrator final : public Integrator {
   int maxDepth_;
   int rrDepth_;
   Strategy strategy_;
+  static void widenFilteredFootprint(const Scene& scene, const PathState& path, SurfaceHit& hit);
+
   bool traceCaustics_;
 };
 

@@ -14,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include "gltf_builder.h"
 #include "test_fixtures.h"
 
 #include <algorithm>
@@ -320,6 +321,86 @@ TEST(FilteredTexture, ATextureThatDisappearsBetweenRendersIsAnErrorNamingIt) {
   EXPECT_NE(cut.exitCode, 0);
   EXPECT_NE(cut.output.find("tail.tx: texture lookups failed"), std::string::npos) << cut.output;
   EXPECT_FALSE(std::filesystem::exists(dir.file("c.exr")));
+}
+
+}  // namespace
+}  // namespace ember
+
+namespace ember {
+namespace {
+
+// glTF images filtered trilinearly (--texture-filter trilinear, LoadOptions::trilinearTextures):
+// a checkerboard of 8-texel squares repeated 64 times over a quad seen whole in a 32 x 24 image
+// spans about 128 texels per pixel, so the filtered base colour is the checkerboard's mean (0.5 after sRGB
+// decoding of 0 and 255) while the bilinear one is black or white; KHR_texture_transform's scale
+// widens the footprint as it shrinks the texture.
+TEST(FilteredTexture, GltfImagesFilterTrilinearlyOnRequest) {
+  REQUIRE_PLUGIN(plugin);
+  TempDir dir;
+  test::GltfBuilder b;
+  std::vector<unsigned char> checker;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) checker.insert(checker.end(), 3, ((x / 8 + y / 8) & 1) ? 255 : 0);
+  tinygltf::Material m;
+  m.pbrMetallicRoughness.baseColorTexture.index = b.addTexture(64, 64, 3, checker);
+  m.pbrMetallicRoughness.metallicFactor = 0.0;
+  b.addQuad(1.0f, b.addMaterial(m), 64.0f);
+  ASSERT_TRUE(b.write(dir.file("checker.gltf")));
+  const auto baseColors = [&](bool trilinear) {
+    LoadOptions options;
+    options.trilinearTextures = trilinear;
+    Scene scene = loadScene(dir.file("checker.gltf"), options);
+    EXPECT_EQ(scene.filteredTextures, trilinear);
+    scene.settings.width = 32;
+    scene.settings.height = 24;
+    scene.build();
+    std::vector<float> values;
+    for (int y = 8; y < 16; y += 2)
+      for (int x = 12; x < 20; x += 2) {
+        SurfaceHit hit;
+        if (!scene.intersect(scene.camera().generateRay(float(x) + 0.37f, float(y) + 0.61f), hit)) continue;
+        const auto* pbr = dynamic_cast<const GltfPbrMaterial*>(hit.material);
+        EXPECT_NE(pbr, nullptr);
+        if (pbr) values.push_back(pbr->inputs().baseColor->evalFresh(hit).x);
+      }
+    return values;
+  };
+  const std::vector<float> filtered = baseColors(true), plain = baseColors(false);
+  ASSERT_EQ(filtered.size(), 16u);
+  ASSERT_EQ(plain.size(), 16u);
+  int extremes = 0;
+  for (size_t i = 0; i < filtered.size(); ++i) {
+    EXPECT_NEAR(filtered[i], 0.5f, 0.05f) << "hit " << i;
+    extremes += plain[i] < 0.1f || plain[i] > 0.9f ? 1 : 0;
+  }
+  EXPECT_GT(extremes, 8);
+}
+
+// A texture that remembers the footprint it was asked for.
+class FootprintProbe final : public Texture {
+ public:
+  mutable float width = -1.0f;
+  Color eval(Vec2) const override { return Color(0.0f); }
+  Color evalFootprint(Vec2, float w) const override {
+    width = w;
+    return Color(0.0f);
+  }
+  Color maxValue() const override { return Color(0.0f); }
+  Color minValue() const override { return Color(0.0f); }
+  Color average() const override { return Color(0.0f); }
+};
+
+TEST(FilteredTexture, TextureTransformsScaleTheFootprint) {
+  const auto probe = std::make_shared<FootprintProbe>();
+  const UvTransformTexture transformed(probe, Vec2(0.1f, 0.2f), 0.7f, Vec2(4.0f, 9.0f));
+  SurfaceHit hit;
+  hit.uv = Vec2(0.3f, 0.4f);
+  hit.uvFootprint = 0.01f;
+  transformed.evalFresh(hit);
+  EXPECT_NEAR(probe->width, 0.06f, 1e-6f);  // 0.01 sqrt(4 x 9)
+  const TexCoordSetTexture set1(probe, 1);
+  set1.evalFresh(hit);
+  EXPECT_EQ(probe->width, 0.01f);
 }
 
 }  // namespace
