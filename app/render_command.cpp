@@ -16,6 +16,7 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <memory>
@@ -44,6 +45,7 @@ struct RenderArgs {
   std::optional<float> envStrength;
   std::string variant;
   std::string textureFilter;
+  std::optional<double> untilRelerr;
   bool quiet = false;
   std::string checkpoint, resume, time;
   double checkpointEvery = 60.0;
@@ -146,6 +148,9 @@ struct RenderSetup {
   std::optional<Checkpoint> resumed;
 };
 
+// --until-relerr without --spp: render until the target, up to this many samples per pixel.
+constexpr int kUntilRelerrSppCap = 65536;
+
 Scene loadConfigured(const std::string& path, int camera, const std::string& variant, const std::string& env,
                      const std::string& textureFilter) {
   LoadOptions loadOptions;
@@ -232,7 +237,10 @@ RenderSetup setUp(RenderArgs& a) {
   if (a.textureFilter == "bilinear") a.textureFilter.clear();  // the samplers' own: the default
   setup.scene = loadConfigured(a.scene, a.camera, a.variant, a.env, a.textureFilter);
   RenderSettings& s = setup.scene.settings;
-  if (a.spp) s.spp = *a.spp;
+  if (a.spp)
+    s.spp = *a.spp;
+  else if (a.untilRelerr)
+    s.spp = kUntilRelerrSppCap;
   if (a.seed) s.seed = *a.seed;
   if (a.width) s.width = *a.width;
   if (a.height) s.height = *a.height;
@@ -294,6 +302,11 @@ int runRender(RenderArgs a) {
   options.passesDone = setup.resumed ? setup.resumed->passes : 0;
   options.stop = &signals.flag();
   options.timeBudgetSeconds = budget;
+  if (a.untilRelerr) {
+    // Each rank holds only its share of every pixel's samples: none could judge the whole.
+    if (cluster.distributed()) throw InputError("--until-relerr cannot be used under MPI");
+    options.targetRelativeError = *a.untilRelerr;
+  }
 
   Checkpoint state;
   state.identity = setup.identity;
@@ -327,22 +340,26 @@ int runRender(RenderArgs a) {
   cluster.reduceToRoot(film);
   if (!cluster.isRoot()) return interrupted ? 128 + (signals.signal() ? signals.signal() : SIGTERM) : 0;
 
-  const Metadata meta{{"ember:scene", setup.identity.scene},
-                      {"ember:scene_hash", hexHash(setup.identity.hash())},
-                      {"ember:spp", std::to_string(sppDone)},
-                      {"ember:spp_requested", std::to_string(s.spp)},
-                      {"ember:passes", std::to_string(stats.passes)},
-                      {"ember:seed", std::to_string(s.seed)},
-                      {"ember:sampler", s.sampler == SamplerType::Sobol ? "sobol" : "independent"},
-                      {"ember:strategy", std::string(strategyName(s.strategy))},
-                      {"ember:caustics", setup.identity.caustics},
-                      {"ember:max_depth", std::to_string(s.maxDepth)},
-                      {"ember:rr_depth", std::to_string(s.rrDepth)},
-                      {"ember:first_sample", std::to_string(setup.firstSample)},
-                      {"ember:render_seconds", std::to_string(stats.seconds)},
-                      {"ember:version", EMBER_VERSION},
-                      {"DateTime", isoTime()},
-                      {"Software", std::string("ember ") + EMBER_VERSION}};
+  Metadata meta{{"ember:scene", setup.identity.scene},
+                {"ember:scene_hash", hexHash(setup.identity.hash())},
+                {"ember:spp", std::to_string(sppDone)},
+                {"ember:spp_requested", std::to_string(s.spp)},
+                {"ember:passes", std::to_string(stats.passes)},
+                {"ember:seed", std::to_string(s.seed)},
+                {"ember:sampler", s.sampler == SamplerType::Sobol ? "sobol" : "independent"},
+                {"ember:strategy", std::string(strategyName(s.strategy))},
+                {"ember:caustics", setup.identity.caustics},
+                {"ember:max_depth", std::to_string(s.maxDepth)},
+                {"ember:rr_depth", std::to_string(s.rrDepth)},
+                {"ember:first_sample", std::to_string(setup.firstSample)},
+                {"ember:render_seconds", std::to_string(stats.seconds)},
+                {"ember:version", EMBER_VERSION},
+                {"DateTime", isoTime()},
+                {"Software", std::string("ember ") + EMBER_VERSION}};
+  if (a.untilRelerr) {
+    meta.push_back({"ember:until_relerr", std::to_string(*a.untilRelerr)});
+    meta.push_back({"ember:relerr", std::to_string(stats.relativeError)});
+  }
   if (sppDone > 0) {
     const Image image = film.mean();
     writeExr(a.output, image, meta);
@@ -368,6 +385,10 @@ int runRender(RenderArgs a) {
                  cluster.size());
   if (stats.outOfTime)
     std::fprintf(stderr, "ember: --time %s: stopped after %d of %d spp\n", a.time.c_str(), sppDone, s.spp);
+  if (a.untilRelerr && !interrupted)
+    std::fprintf(stderr, "ember: --until-relerr %g: %s %.4g at %d spp\n", *a.untilRelerr,
+                 stats.converged ? "reached" : "not reached, estimated relative error", stats.relativeError,
+                 sppDone);
   if (interrupted) {
     const std::string resume = !a.checkpoint.empty() ? a.checkpoint : a.resume;
     std::fprintf(stderr, "ember: interrupted after %d of %d spp%s\n", sppDone, s.spp,
@@ -438,6 +459,21 @@ Runner addRenderCommand(CLI::App& app) {
                   "equirectangular EXR/HDR map; replaces the scene's or the default one");
   cmd->add_option("--env-strength", args->envStrength, "Multiplies the --env light (default 1)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--until-relerr", args->untilRelerr,
+                  "Stop once the image's estimated relative error (the root of the relMSE it is expected to "
+                  "have against its converged self, from the per-pixel variance) is at most this, checked "
+                  "before every pass; --spp is then the most it may take (default 65536). The EXR records "
+                  "the estimate (ember:relerr)")
+      ->check(CLI::Validator(
+          [](std::string& v) {
+            // CLI::PositiveNumber lets "nan" through, and a NaN target would never be reached.
+            char* end = nullptr;
+            const double d = std::strtod(v.c_str(), &end);
+            return end != v.c_str() && *end == '\0' && std::isfinite(d) && d > 0.0
+                       ? std::string()
+                       : "expected a positive number, got '" + v + "'";
+          },
+          "POSITIVE"));
   cmd->add_option("--texture-filter", args->textureFilter,
                   "glTF files: how their images are filtered: bilinear (the default; nearest where a sampler "
                   "asks) or trilinear (MIP-mapped over each hit's pixel footprint through OpenImageIO: less "

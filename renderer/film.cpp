@@ -1,6 +1,8 @@
 #include "renderer/film.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 namespace ember {
 
@@ -33,6 +35,19 @@ Image Film::varianceOfMean() const {
       img.set(x, y, Color(var / n));
     }
   return img;
+}
+
+double Film::relativeError() const {
+  double sum = 0.0;
+  for (size_t i = 0; i < count_.size(); ++i) {
+    const double n = count_[i];
+    if (n < 2) return std::numeric_limits<double>::infinity();
+    const glm::dvec3 m = sum_[i] / n;
+    const glm::dvec3 varOfMean = glm::max(glm::dvec3(0.0), (sumSq_[i] - n * m * m) / (n - 1.0)) / n;
+    const glm::dvec3 rel = varOfMean / (m * m + 0.01);
+    sum += rel.x + rel.y + rel.z;
+  }
+  return count_.empty() ? 0.0 : std::sqrt(sum / double(3 * count_.size()));
 }
 
 void Film::save(int x0, int y0, int x1, int y1, TileBackup& backup) const {

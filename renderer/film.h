@@ -48,6 +48,11 @@ class Film {
   Image mean() const;
   // Variance of each pixel's mean: sample variance / n (unbiased, n - 1 in the denominator).
   Image varianceOfMean() const;
+  // The image's estimated relative error: sqrt of the mean over pixels and channels of
+  // Var(mean) / (mean^2 + 0.01), i.e. the root of the relMSE (Rousselle et al. 2011's regularised
+  // form, as `ember compare` reports it) the image is expected to have against its converged
+  // self, from the film's own variance. Infinite while some pixel holds fewer than 2 samples.
+  double relativeError() const;
 
   // The accumulation state itself, pixel by pixel (checkpoint files store and restore it exactly).
   size_t pixelCount() const { return count_.size(); }

@@ -70,6 +70,10 @@ RenderStats render(const Scene& scene, const Integrator& integrator, const Rende
       stats.interrupted = true;
       break;
     }
+    if (options.targetRelativeError > 0.0 && film.relativeError() <= options.targetRelativeError) {
+      stats.converged = true;
+      break;
+    }
     const auto passStart = Clock::now();
     std::fill(rendered.begin(), rendered.end(), 0);
     const uint64_t passFirstSample = options.firstSample + uint64_t(p) * uint64_t(passSpp);
@@ -130,6 +134,10 @@ RenderStats render(const Scene& scene, const Integrator& integrator, const Rende
     if (options.onPass) options.onPass(film, stats.passes);
   }
   progress.finish();
+  if (options.targetRelativeError > 0.0) {
+    stats.relativeError = film.relativeError();
+    stats.converged = stats.relativeError <= options.targetRelativeError;
+  }
   stats.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   stats.sppDone = std::min(options.spp, stats.passes * passSpp);
   stats.nonFinite = stats.paths.nonFinite;

@@ -33,6 +33,10 @@ struct RenderOptions {
   // back, so the film holds whole passes only. Null: nothing can interrupt.
   const std::atomic<bool>* stop = nullptr;
   double timeBudgetSeconds = 0.0;  // > 0: no pass starts that the last one's time says won't fit
+  // > 0: no pass starts once the film's Film::relativeError() is at most this. The check depends
+  // on the film alone, before every pass (the first of a resumed render's too), so a render
+  // stopped and resumed ends at the same pass as one run through.
+  double targetRelativeError = 0.0;
   // Called after each completed pass with the number of passes the film now holds.
   std::function<void(const Film&, int passes)> onPass;
 };
@@ -45,12 +49,14 @@ inline int passCount(int spp, int passSpp) {
 struct RenderStats {
   double seconds = 0.0;
   int threads = 0;
-  uint64_t samples = 0;      // samples per pixel added by this call, times the pixel count
-  int passes = 0;            // passes the film holds at the end (earlier ones included)
-  int sppDone = 0;           // samples per pixel the film holds at the end
-  bool interrupted = false;  // options.stop was set
-  bool outOfTime = false;    // the time budget ended the render before options.spp
-  uint64_t nonFinite = 0;    // samples dropped because they were NaN or infinite
+  uint64_t samples = 0;        // samples per pixel added by this call, times the pixel count
+  int passes = 0;              // passes the film holds at the end (earlier ones included)
+  int sppDone = 0;             // samples per pixel the film holds at the end
+  bool interrupted = false;    // options.stop was set
+  bool outOfTime = false;      // the time budget ended the render before options.spp
+  bool converged = false;      // the film reached options.targetRelativeError
+  double relativeError = 0.0;  // Film::relativeError() at the end, when a target was set
+  uint64_t nonFinite = 0;      // samples dropped because they were NaN or infinite
   PathStats paths;
 };
 

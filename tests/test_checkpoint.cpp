@@ -11,6 +11,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "cli_runner.h"
 #include "test_fixtures.h"
 #include "test_paths.h"
@@ -130,6 +132,57 @@ TEST(Passes, TimeBudgetStopsBeforeAPassThatWouldNotFit) {
   // Generous: the check is that the budget stops the render, not how fast this machine is.
   EXPECT_LT(s, 0.3 * 3.0 + 1.0) << "the budget was overrun";
   for (uint32_t n : film.counts()) EXPECT_EQ(n, uint32_t(st.sppDone));
+}
+
+// --until-relerr (RenderOptions::targetRelativeError): the render stops before the first pass
+// at which the film's estimated relative error is within the target, so one pass fewer is still
+// above it; the stop depends on the film alone, so a render cut short and resumed stops at the same
+// pass with the same film, bit for bit.
+TEST(Passes, ARelativeErrorTargetStopsAtTheFirstPassWithinIt) {
+  const Scene scene = smallScene(24);
+  const auto integrator = makeIntegrator(scene.settings, Kernel::Wave);
+  const double target = 0.05;
+  Film film(24, 24);
+  RenderOptions o = optionsFor(scene, 4096, 4);
+  o.targetRelativeError = target;
+  const RenderStats st = render(scene, *integrator, o, film);
+  ASSERT_TRUE(st.converged);
+  EXPECT_LE(st.relativeError, target);
+  EXPECT_EQ(st.relativeError, film.relativeError());
+  EXPECT_GT(st.sppDone, 4);
+  EXPECT_LT(st.sppDone, 4096);
+  Film fewer(24, 24);
+  render(scene, *integrator, optionsFor(scene, st.sppDone - 4, 4), fewer);
+  EXPECT_GT(fewer.relativeError(), target);
+
+  // Cut after two passes, then resumed with the same target.
+  Film resumed(24, 24);
+  RenderOptions first = optionsFor(scene, 8, 4);
+  render(scene, *integrator, first, resumed);
+  RenderOptions rest = optionsFor(scene, 4096, 4);
+  rest.passesDone = 2;
+  rest.targetRelativeError = target;
+  const RenderStats after = render(scene, *integrator, rest, resumed);
+  EXPECT_EQ(after.sppDone, st.sppDone);
+  EXPECT_TRUE(sameFilm(resumed, film));
+
+  // A film already within the target renders no further pass.
+  const RenderStats none = render(scene, *integrator, rest, resumed);
+  EXPECT_TRUE(none.converged);
+  EXPECT_EQ(none.samples, 0u);
+}
+
+// Film::relativeError against its definition: two samples, 1 and 3, in every channel of every
+// pixel: mean 2, sample variance 2, variance of the mean 1, so sqrt(1 / (4 + 0.01)).
+TEST(Passes, RelativeErrorIsTheExpectedRelMseRoot) {
+  Film film(3, 2);
+  EXPECT_TRUE(std::isinf(film.relativeError()));
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 3; ++x) {
+      film.addSample(x, y, Color(1.0f));
+      film.addSample(x, y, Color(3.0f));
+    }
+  EXPECT_NEAR(film.relativeError(), std::sqrt(1.0 / 4.01), 1e-12);
 }
 
 Checkpoint sampleCheckpoint() {
@@ -451,6 +504,42 @@ TEST(MergeCli, SampleRangesMergeIntoTheirUnion) {
                 .exitCode,
             1);
   EXPECT_FALSE(std::filesystem::exists(dir.file("x.exr")));
+}
+
+}  // namespace
+}  // namespace ember
+
+namespace ember {
+namespace {
+
+// `ember render --until-relerr`: the EXR records the target and the estimate reached; a target
+// that is not a positive number is refused, and nothing is written.
+TEST(CheckpointCli, UntilRelerrRecordsTheEstimateAndRefusesBadTargets) {
+  test::TempDir dir;
+  const std::string scene = test::sourcePath("scenes/cornell-area.json");
+  const std::string out = dir.file("until.exr");
+  const test::CliResult r = test::runEmber("render '" + scene + "' -o '" + out +
+                                           "' --width 32 --height 24 --until-relerr 0.08 -q --threads 2");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("--until-relerr 0.08: reached"), std::string::npos) << r.output;
+  const Metadata meta = readStringMetadata(out);
+  const auto value = [&](const std::string& key) {
+    for (const auto& [k, v] : meta)
+      if (k == key) return v;
+    return std::string();
+  };
+  ASSERT_FALSE(value("ember:relerr").empty());
+  EXPECT_LE(std::stod(value("ember:relerr")), 0.08);
+  EXPECT_EQ(value("ember:spp_requested"), "65536");
+  EXPECT_LT(std::stoi(value("ember:spp")), 65536);
+  for (const char* bad : {"0", "-1", "nan", "x"}) {
+    const std::string none = dir.file(std::string("bad") + bad + ".exr");
+    EXPECT_NE(test::runEmber("render '" + scene + "' -o '" + none + "' --spp 4 --until-relerr " + bad + " -q")
+                  .exitCode,
+              0)
+        << bad;
+    EXPECT_FALSE(std::filesystem::exists(none)) << bad;
+  }
 }
 
 }  // namespace

@@ -137,6 +137,35 @@ Scene::ShapeEntry& shapeNamed(Scene& scene, const std::string& name) {
   throw std::runtime_error("no shape " + name);
 }
 
+// Renders stopped by a relative-error target (--until-relerr, RenderOptions::targetRelativeError)
+// still agree with the references: the pass they stop at depends on their own noise, which must
+// not bias the image. Two seeds, each stopped at 0.07 (about 60 spp), z-tested as above.
+TEST(ReferenceImageStopping, RelativeErrorTargetStaysUnbiased) {
+  for (const std::string name : {"cornell-area", "shapes"}) {
+    Scene scene = loadJsonScene(test::sourcePath("scenes/" + name + ".json"));
+    scene.build();
+    const std::unique_ptr<Integrator> integrator = makeIntegrator(scene.settings, Kernel::Wave);
+    Rendered runs[2];
+    for (int k = 0; k < 2; ++k) {
+      Film film(scene.settings.width, scene.settings.height);
+      RenderOptions options;
+      options.spp = 4096;
+      options.seed = uint64_t(k + 1);
+      options.targetRelativeError = 0.07;
+      const RenderStats stats = render(scene, *integrator, options, film);
+      EXPECT_TRUE(stats.converged) << name;
+      EXPECT_EQ(stats.nonFinite, 0u) << name;
+      runs[k] = {film.mean(), film.varianceOfMean()};
+      std::printf("[ %s ] seed %d stopped at %d spp, estimated relative error %.4f\n", name.c_str(), k + 1,
+                  stats.sppDone, stats.relativeError);
+    }
+    const Reference ref = loadReference(name);
+    const Rendered both = average(runs[0], runs[1]);
+    const BlockZTestResult r = blockZTest(both.mean, both.variance, ref.mean, ref.variance, kBlock, kAlpha);
+    EXPECT_TRUE(r.passes()) << name << " vs reference: " << describe(r);
+  }
+}
+
 TEST(ReferenceImagePower, FailsWhenTheLightIsTwiceAsBright) {
   const auto r = compareMutated("cornell-area", [](Scene& s) { shapeNamed(s, "light").emission *= 2.0f; });
   EXPECT_FALSE(r.passes()) << describe(r);
