@@ -327,12 +327,16 @@ int runRender(RenderArgs a) {
   if (checkpointing)
     options.onPass = [&](const Film& f, int passes) {
       if (std::chrono::duration<double>(Clock::now() - lastSave).count() < a.checkpointEvery) return;
+      if (!filteredTextureFailure().empty()) return;  // never a checkpoint with black lookups
       saveState(f, passes);
       lastSave = Clock::now();
     };
   const RenderStats stats = render(scene, *integrator, options, film);
-  // A texture file that vanished mid-render made some lookups black: nothing is written.
-  if (const std::string failure = filteredTextureFailure(); !failure.empty()) throw InputError(failure);
+  // A texture file that vanished mid-render made some lookups black: nothing is written, on any
+  // rank.
+  if (const std::string failure = filteredTextureFailure(); cluster.any(!failure.empty()))
+    throw InputError(failure.empty() ? "another MPI rank's texture lookups failed during the render"
+                                     : failure);
   if (checkpointing) saveState(film, stats.passes);
   // Rank 0 gathers the other ranks' sums; only it writes images and reports.
   const bool interrupted = cluster.any(stats.interrupted);

@@ -15,9 +15,11 @@ std::mutex failureMutex;
 std::string firstFailure;
 
 void recordFailure(const std::string& name) {
-  if (anyFailure.exchange(true)) return;
+  if (anyFailure.load(std::memory_order_relaxed)) return;
   std::lock_guard<std::mutex> lock(failureMutex);
+  if (!firstFailure.empty()) return;
   firstFailure = name + ": texture lookups failed during the render (the file disappeared or changed?)";
+  anyFailure.store(true);
 }
 
 ImagePlugin::Wrap pluginWrap(TextureWrap wrap) {

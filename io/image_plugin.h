@@ -60,7 +60,8 @@ class ImagePlugin {
   // Fills `info` and returns the handle, or nullptr and the reason (without the file's name) in
   // `error`. Also nullptr, with `error` empty, for a file this cannot serve as stored: integers
   // when `integersAreLinear` is false (they are sRGB-encoded, and the texture system would filter
-  // the encoded values), or two channels (grey and alpha).
+  // the encoded values), two channels (grey and alpha), or negative texels (which the decoder
+  // clamps to 0). NaN or infinite texels are an error.
   virtual const void* addTextureFile(const std::string& path, bool integersAreLinear, TextureFile& info,
                                      std::string& error) const = 0;
   enum class Wrap { Clamp, Repeat, Mirror };

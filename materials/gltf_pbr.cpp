@@ -12,7 +12,10 @@
 //    thin-walled transmission straight through with dielectric t (1 - w max3(Fd)) baseColor, and
 //    refraction with dielectric t (1 - F) baseColor / eta^2 (the radiance scaling, as Dielectric
 //    in specular.h). The diffuse and sheen lobes are unchanged; the lobe probabilities are the
-//    same, a Dirac lobe's being its sample's pdf. So glTF glass and polished metal cast caustics
+//    same, a Dirac lobe's being its sample's pdf. A smooth refraction's sheen and coat factor is
+//    taken at its one outside direction whichever side wo is on (the outer coating is crossed
+//    either way), so the path tracer and the light tracer, which meet the pair in opposite
+//    orders, weigh it alike. So glTF glass and polished metal cast caustics
 //    that the light tracer can follow (renderer/caustic_tracer.h), and the path tracer's images
 //    are those of the alpha -> 0 limit rather than of alpha = 1e-3.
 //  - Reflection is two-sided, like Lambertian: the shading frame is the shading normal turned to
@@ -107,12 +110,17 @@ GltfPbrMaterial::GltfPbrMaterial(GltfPbrInputs inputs) : inputs_(std::move(input
 
   // Where a roughness can reach the clamp (anisotropy only widens the lobe, so it is ignored
   // here: the test is for "may be smooth").
-  const float smoothRoughness = std::sqrt(Ggx::kMinAlpha);
+  // The same test as fetch's Params::smooth (alpha = roughness^2 at the clamp), so the two agree to
+  // the last bit of rounding.
+  const auto smooth = [](float roughness) {
+    const float r = std::clamp(roughness, 0.0f, 1.0f);
+    return r * r <= Ggx::kMinAlpha;
+  };
   const auto smoothSomewhere = [&](const std::shared_ptr<const Texture>& t, int channel, float absent) {
-    return (t ? t->minValue()[channel] : absent) <= smoothRoughness;
+    return smooth(t ? t->minValue()[channel] : absent);
   };
   const auto smoothEverywhere = [&](const std::shared_ptr<const Texture>& t, int channel, float absent) {
-    return (t ? t->maxValue()[channel] : absent) <= smoothRoughness;
+    return smooth(t ? t->maxValue()[channel] : absent);
   };
   deltaLobes_ = smoothSomewhere(inputs_.metallicRoughness, 1, 1.0f) ||
                 (coat_ && smoothSomewhere(inputs_.clearcoatRoughness, 0, 0.0f));
@@ -357,6 +365,13 @@ float GltfPbrMaterial::baseScale(const Params& p, const Frames& f, float iz) con
   return scale;
 }
 
+float GltfPbrMaterial::outerLayerScale(const Params& p, float cosBase, float cosCoat) const {
+  float scale = 1.0f;
+  if (sheen_) scale = std::max(0.0f, 1.0f - maxOf(p.sheenColor) * sheenAlbedo(cosBase, p.sheenRoughness));
+  if (coat_ && cosCoat > 0.0f) scale *= 1.0f - p.clearcoat * schlickFresnel(kCoatF0, cosCoat);
+  return scale;
+}
+
 Color GltfPbrMaterial::evalLayers(const Params& p, const LobeProbabilities& lobes, const Frames& f,
                                   const SurfaceHit& hit, const Vec3& wo, const Vec3& wi, float& pdf) const {
   const bool reflection = sameSide(hit, wo, wi);
@@ -494,6 +509,21 @@ bool GltfPbrMaterial::sampleDelta(const Params& p, const LobeProbabilities& lobe
         if (!refract(o, Vec3(0.0f, 0.0f, 1.0f), eta, i)) return false;
         const float F = p.specularWeight * maxOf(schlickFresnel(p.specularF0, f.outside ? o.z : -i.z));
         value = (scale * (1.0f - F) / (eta * eta)) * p.baseColor;
+        // The sheen and the coat lie on the outer surface, which light crosses whichever way it
+        // goes: weighed at the outside direction's cosines from both sides, so that a pair taken
+        // camera side first (the path tracer) or light side first (the light tracer, which owns
+        // these caustics) carries the same factor.
+        const Vec3 outsideDir = f.outside ? wo : f.base.toWorld(i);
+        value *= outerLayerScale(p, f.outside ? o.z : -i.z, glm::dot(outsideDir, p.coatNormal));
+        probability = lobes.transmission;
+        if (!(probability > 0.0f)) return false;
+        out.wi = glm::normalize(f.base.toWorld(i));
+        if (sameSide(hit, wo, out.wi)) return false;
+        out.weight = value / probability;
+        out.pdf = probability;
+        out.delta = true;
+        out.eta = eta;
+        return true;
       }
       probability = lobes.transmission;
     }

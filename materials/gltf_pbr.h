@@ -151,6 +151,9 @@ class GltfPbrMaterial final : public Material {
   // What the sheen and the coat leave of the base for a direction of local cosine iz: the base's
   // lobes are multiplied by it.
   float baseScale(const Params& p, const Frames& f, float iz) const;
+  // The same for a smooth refraction, from the cosines of its one outside direction with the
+  // base's and the coat's normals: symmetric in the pair's two directions.
+  float outerLayerScale(const Params& p, float cosBase, float cosCoat) const;
   // sample() through a Dirac lobe (lobe: 0 coat, 1 specular, 2 transmission).
   bool sampleDelta(const Params& p, const LobeProbabilities& lobes, const Frames& f, const SurfaceHit& hit,
                    const Vec3& wo, int lobe, BsdfSample& out) const;

@@ -224,8 +224,8 @@ TEST(CausticEstimators, EmissiveMeshLightAgreesWithThePathTracerAlone) {
 }
 
 // glTF glass (KHR_materials_transmission and _volume at roughness 0: a Dirac refraction, so the
-// mesh is a caster) and a glTF polished metal plate (metallic 1, roughness 0), both with a
-// colour, under the quad light: the light tracer follows their Dirac lobes from the light, and
+// mesh is a caster; with a clearcoat and a sheen) and a glTF polished metal plate (metallic 1, roughness 0),
+// both with a colour, under the quad light: the light tracer follows their Dirac lobes from the light, and
 // the path tracer must agree.
 TEST(CausticEstimators, GltfGlassAndPolishedMetalAgreeWithThePathTracerAlone) {
   const test::TempDir dir;
@@ -237,11 +237,17 @@ TEST(CausticEstimators, GltfGlassAndPolishedMetalAgreeWithThePathTracerAlone) {
   glass.pbrMetallicRoughness.roughnessFactor = 0.0;
   glass.extensions["KHR_materials_transmission"] = V(V::Object{{"transmissionFactor", V(1.0)}});
   glass.extensions["KHR_materials_volume"] = V(V::Object{{"thicknessFactor", V(0.8)}});
+  // A clearcoat and a sheen, whose weights depend on the direction outside: the two tracers meet
+  // each refraction from opposite sides and must weigh it alike.
+  glass.extensions["KHR_materials_clearcoat"] = V(V::Object{{"clearcoatFactor", V(1.0)}});
+  glass.extensions["KHR_materials_sheen"] = V(
+      V::Object{{"sheenColorFactor", V(V::Array{V(1.0), V(1.0), V(1.0)})}, {"sheenRoughnessFactor", V(0.5)}});
   tinygltf::Material metal;
   metal.pbrMetallicRoughness.baseColorFactor = {0.9, 0.8, 0.6, 1.0};
   metal.pbrMetallicRoughness.metallicFactor = 1.0;
   metal.pbrMetallicRoughness.roughnessFactor = 0.0;
-  b.model().extensionsUsed = {"KHR_materials_transmission", "KHR_materials_volume"};
+  b.model().extensionsUsed = {"KHR_materials_transmission", "KHR_materials_volume",
+                              "KHR_materials_clearcoat"};
   const float center[3] = {0.5f, 0.75f, -0.2f};
   b.addSphere(center, 0.4f, b.addMaterial(glass), 32, 64);
   const std::vector<test::GltfBuilder::Vertex> plate = {

@@ -534,7 +534,7 @@ TEST(CheckpointCli, UntilRelerrRecordsTheEstimateAndRefusesBadTargets) {
   EXPECT_LT(std::stoi(value("ember:spp")), 65536);
   for (const char* bad : {"0", "-1", "nan", "x"}) {
     const std::string none = dir.file(std::string("bad") + bad + ".exr");
-    EXPECT_NE(test::runEmber("render '" + scene + "' -o '" + none + "' --spp 4 --until-relerr " + bad + " -q")
+    EXPECT_NE(test::runEmber("render '" + scene + "' -o '" + none + "' --spp 4 --until-relerr=" + bad + " -q")
                   .exitCode,
               0)
         << bad;

@@ -18,6 +18,7 @@
 #include "test_fixtures.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <random>
 
@@ -284,6 +285,18 @@ TEST(FilteredTexture, FromItsFileItEqualsTheDecodedImage) {
   EXPECT_NE(plugin->addTextureFile(dir.file("u8.tx"), true, byteInfo, error), nullptr) << error;
   EXPECT_EQ(plugin->addTextureFile(dir.file("missing.tx"), false, byteInfo, error), nullptr);
   EXPECT_NE(error, "");
+  // A NaN texel is an error; a negative one leaves the file to the decoder, which clamps it.
+  std::vector<Color> odd = randomTexels(8, 8, 6);
+  odd[9].y = std::nanf("");
+  ASSERT_EQ(plugin->write(dir.file("nan.tx"), floatPixels(odd, 8, 8)), "");
+  error.clear();
+  EXPECT_EQ(plugin->addTextureFile(dir.file("nan.tx"), false, byteInfo, error), nullptr);
+  EXPECT_NE(error.find("NaN"), std::string::npos) << error;
+  odd[9].y = -0.5f;
+  ASSERT_EQ(plugin->write(dir.file("negative.tx"), floatPixels(odd, 8, 8)), "");
+  error.clear();
+  EXPECT_EQ(plugin->addTextureFile(dir.file("negative.tx"), false, byteInfo, error), nullptr);
+  EXPECT_EQ(error, "");
 }
 
 // A scene's trilinear texture whose file is gone by the next render (a resume, a re-render) is

@@ -146,8 +146,10 @@ oiio::TextureSystem& textureSystem() {
       if (v > 0.0f && std::isfinite(v)) megabytes = v;
     }
     t->attribute("max_memory_MB", megabytes);
-    // A grey file's one channel answers for all three.
+    // A grey file's one channel answers for all three; colours unpremultiplied, as read() reads
+    // them (glTF and scene textures are not premultiplied by their alpha).
     t->attribute("gray_to_rgb", 1);
+    t->attribute("unassociatedalpha", 1);
     return t;
   }();
   return *ts;
@@ -237,7 +239,7 @@ class OiioImagePlugin final : public ImagePlugin {
     oiio::ImageCache& cache = *ts.imagecache();
     const oiio::ustring name(path);
     oiio::ImageSpec spec;
-    if (!cache.get_imagespec(name, spec, 0, 0)) {
+    if (!cache.get_imagespec(name, spec, 0, 0, /*native=*/true)) {
       error = cache.geterror();
       if (error.empty()) error = "cannot open it";
       return nullptr;
@@ -284,11 +286,18 @@ class OiioImagePlugin final : public ImagePlugin {
       for (int x = 0; x < spec.width; ++x)
         for (int c = 0; c < 3; ++c) {
           const float v = row[size_t(x) * size_t(nc) + size_t(std::min(c, nc - 1))];
+          if (!std::isfinite(v)) {
+            error =
+                "texel (" + std::to_string(x) + ", " + std::to_string(y - spec.y) + ") is NaN or infinite";
+            return nullptr;
+          }
           lo[c] = std::min(lo[c], v);
           hi[c] = std::max(hi[c], v);
           sum[c] += double(v);
         }
     }
+    // Negative texels: the decoder clamps them to 0, which lookups from the file could not.
+    if (lo[0] < 0.0f || lo[1] < 0.0f || lo[2] < 0.0f) return nullptr;
     const double texels = double(spec.width) * double(spec.height);
     for (int c = 0; c < 3; ++c) {
       info.min[c] = lo[c];
