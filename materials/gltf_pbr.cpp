@@ -108,10 +108,9 @@ GltfPbrMaterial::GltfPbrMaterial(GltfPbrInputs inputs) : inputs_(std::move(input
   film_ = inputs_.iridescence && inputs_.iridescence->maxValue().x > 0.0f;
   anisotropic_ = inputs_.anisotropyStrength > 0.0f;
 
-  // Where a roughness can reach the clamp (anisotropy only widens the lobe, so it is ignored
-  // here: the test is for "may be smooth").
-  // The same test as fetch's Params::smooth (alpha = roughness^2 at the clamp), so the two agree to
-  // the last bit of rounding.
+  // Where a roughness can reach the clamp: the same test as fetch's Params::smooth (alpha =
+  // roughness^2 at the clamp), so the two agree to the last bit of rounding. Anisotropy only widens
+  // the lobe, so "may be smooth" ignores it.
   const auto smooth = [](float roughness) {
     const float r = std::clamp(roughness, 0.0f, 1.0f);
     return r * r <= Ggx::kMinAlpha;
@@ -238,9 +237,12 @@ bool GltfPbrMaterial::frames(const SurfaceHit& hit, const Vec3& wo, const Params
   return true;
 }
 
+float GltfPbrMaterial::coatWeightAt(const Params& p, float cosCoat) const {
+  return coat_ && cosCoat > 0.0f ? p.clearcoat * schlickFresnel(kCoatF0, cosCoat) : 0.0f;
+}
+
 float GltfPbrMaterial::coatWeight(const Params& p, const Frames& f) const {
-  if (!coat_ || !f.layers || !(f.oc.z > 0.0f)) return 0.0f;
-  return p.clearcoat * schlickFresnel(kCoatF0, f.oc.z);
+  return f.layers ? coatWeightAt(p, f.oc.z) : 0.0f;
 }
 
 GltfPbrMaterial::LobeProbabilities GltfPbrMaterial::lobeProbabilities(const Params& p,
@@ -368,7 +370,7 @@ float GltfPbrMaterial::baseScale(const Params& p, const Frames& f, float iz) con
 float GltfPbrMaterial::outerLayerScale(const Params& p, float cosBase, float cosCoat) const {
   float scale = 1.0f;
   if (sheen_) scale = std::max(0.0f, 1.0f - maxOf(p.sheenColor) * sheenAlbedo(cosBase, p.sheenRoughness));
-  if (coat_ && cosCoat > 0.0f) scale *= 1.0f - p.clearcoat * schlickFresnel(kCoatF0, cosCoat);
+  if (coat_) scale *= 1.0f - coatWeightAt(p, cosCoat);
   return scale;
 }
 
@@ -515,19 +517,10 @@ bool GltfPbrMaterial::sampleDelta(const Params& p, const LobeProbabilities& lobe
         // these caustics) carries the same factor.
         const Vec3 outsideDir = f.outside ? wo : f.base.toWorld(i);
         value *= outerLayerScale(p, f.outside ? o.z : -i.z, glm::dot(outsideDir, p.coatNormal));
-        probability = lobes.transmission;
-        if (!(probability > 0.0f)) return false;
-        out.wi = glm::normalize(f.base.toWorld(i));
-        if (sameSide(hit, wo, out.wi)) return false;
-        out.weight = value / probability;
-        out.pdf = probability;
-        out.delta = true;
-        out.eta = eta;
-        return true;
       }
       probability = lobes.transmission;
     }
-    value *= baseScale(p, f, i.z);
+    if (lobe != 2 || !refracts_) value *= baseScale(p, f, i.z);
     wi = f.base.toWorld(i);
   }
   if (!(probability > 0.0f)) return false;

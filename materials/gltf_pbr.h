@@ -141,7 +141,9 @@ class GltfPbrMaterial final : public Material {
   // The reflectances at cos(v, h) of the dielectric (before the specular weight) and of the metal,
   // with the thin film of KHR_materials_iridescence mixed in where there is one.
   void reflectances(const Params& p, float cosOH, bool outside, Color& dielectric, Color& metal) const;
-  // The clearcoat's Fresnel weight, clearcoat x schlick(0.04, n_c.v).
+  // The clearcoat's Fresnel weight, clearcoat x schlick(0.04, n_c.v), for wo (coatWeight) or for
+  // a direction of cosine cosCoat with the coat's normal (0 below it).
+  float coatWeightAt(const Params& p, float cosCoat) const;
   float coatWeight(const Params& p, const Frames& f) const;
   // f |cos theta_i| of the base (Appendix B with specular and transmission) and the mixture pdf of
   // its lobes, in the base frame (o.z > 0); `reflection`: wi lies on wo's side of the geometric
