@@ -1,7 +1,9 @@
 // `ember merge A.exr B.exr ... -o out.exr`: renders of disjoint sample ranges of one render
 // (--first-sample, separate machines or MPI-less clusters) combined into the image of their union.
 // Each input's mean is weighted by its spp, in double; the result equals one render of all the
-// ranges to float rounding of the inputs (about 1e-7 relative).
+// ranges to float rounding of the inputs (about 1e-7 relative). AOV layers (docs/aovs.md) merge by
+// their own definitions: per-sample means by spp, depth, position and uv by the samples that hit a
+// surface (spp times coverage), the variance from each input's sums it gives back, spp by adding.
 #include "app/commands.h"
 
 #include "io/image_io.h"
@@ -9,6 +11,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <memory>
 #include <string>
@@ -28,12 +31,13 @@ struct MergeArgs {
 // The keys that must agree between inputs: together they say "the same render".
 // The settings first, so that an error names the one that differs; the scene hash covers them too.
 constexpr const char* kIdentityKeys[] = {"ember:seed",      "ember:sampler",  "ember:strategy",
-                                         "ember:max_depth", "ember:rr_depth", "ember:scene_hash"};
+                                         "ember:max_depth", "ember:rr_depth", "ember:scene_hash",
+                                         "ember:aovs"};
 
 struct Input {
   std::string path;
   std::map<std::string, std::string> meta;
-  Image image;
+  ExrChannels exr;
   uint64_t first = 0;
   uint64_t spp = 0;
 };
@@ -63,11 +67,14 @@ int runMerge(const MergeArgs& a) {
   for (const std::string& path : a.inputs) {
     Input in;
     in.path = path;
-    for (auto& [k, v] : readStringMetadata(path)) in.meta[k] = v;
+    in.exr = readExrChannels(path);
+    for (auto& [k, v] : in.exr.metadata) in.meta[k] = v;
+    if (!in.meta.count("ember:aovs")) in.meta["ember:aovs"] = "none";  // written before AOVs, or without
     in.first = number(in, "ember:first_sample");
     in.spp = number(in, "ember:spp");
     if (in.spp == 0) throw InputError(path + ": holds no samples");
-    in.image = readImageRgb(path);
+    for (const char* c : {"R", "G", "B"})
+      if (!in.exr.has(c)) throw InputError(path + ": no " + c + " channel: not an image rendered by Ember");
     inputs.push_back(std::move(in));
   }
   const Input& base = inputs.front();
@@ -80,10 +87,13 @@ int runMerge(const MergeArgs& a) {
         throw InputError(in.path + ": " + key + " is " + mine->second + ", but " + base.path + " has " +
                          theirs->second + ": they are not sample ranges of the same render");
     }
-    if (in.image.width != base.image.width || in.image.height != base.image.height)
-      throw InputError(in.path + ": " + std::to_string(in.image.width) + "x" +
-                       std::to_string(in.image.height) + " pixels, but " + base.path + " has " +
-                       std::to_string(base.image.width) + "x" + std::to_string(base.image.height));
+    if (in.exr.width != base.exr.width || in.exr.height != base.exr.height)
+      throw InputError(in.path + ": " + std::to_string(in.exr.width) + "x" + std::to_string(in.exr.height) +
+                       " pixels, but " + base.path + " has " + std::to_string(base.exr.width) + "x" +
+                       std::to_string(base.exr.height));
+    for (const auto& [name, data] : base.exr.channels)
+      if (!in.exr.has(name))
+        throw InputError(in.path + ": no " + name + " channel, which " + base.path + " has");
   }
   // Disjoint ranges: sorted by first sample, each must end before the next begins.
   std::vector<const Input*> order;
@@ -98,12 +108,74 @@ int runMerge(const MergeArgs& a) {
 
   uint64_t total = 0;
   for (const Input& in : inputs) total += in.spp;
-  Image out(base.image.width, base.image.height);
-  for (size_t i = 0; i < out.rgb.size(); ++i) {
-    double sum = 0.0;
-    for (const Input& in : inputs) sum += double(in.image.rgb[i]) * double(in.spp);
-    out.rgb[i] = float(sum / double(total));
+  const int width = base.exr.width, height = base.exr.height;
+  const size_t pixels = size_t(width) * size_t(height);
+  // Input k's samples at pixel i: its spp layer's, else its spp everywhere.
+  const auto samples = [&](const Input& in, size_t i) {
+    const auto it = in.exr.channels.find("spp");
+    return it != in.exr.channels.end() ? double(it->second[i]) : double(in.spp);
+  };
+  const auto hits = [&](const Input& in, size_t i) {
+    const auto it = in.exr.channels.find("coverage");
+    return samples(in, i) * (it != in.exr.channels.end() ? double(it->second[i]) : 1.0);
+  };
+  // Every channel: a mean over the samples (weights `samples`) or over the hits (`hits`).
+  std::map<std::string, std::vector<float>> merged;
+  for (const auto& [name, data] : base.exr.channels) {
+    if (name == "spp" || name.rfind("variance.", 0) == 0) continue;
+    const bool overHits = name == "Z" || name.rfind("P.", 0) == 0 || name.rfind("uv.", 0) == 0;
+    std::vector<float>& out = merged[name];
+    out.resize(pixels);
+    for (size_t i = 0; i < pixels; ++i) {
+      double sum = 0.0, weight = 0.0;
+      for (const Input& in : inputs) {
+        const double w = overHits ? hits(in, i) : samples(in, i);
+        if (w > 0.0) sum += double(in.exr.channels.at(name)[i]) * w;
+        weight += w;
+      }
+      out[i] = weight > 0.0  ? float(sum / weight)
+               : name == "Z" ? std::numeric_limits<float>::infinity()
+                             : 0.0f;
+    }
   }
+  if (base.exr.has("spp")) {
+    std::vector<float>& out = merged["spp"];
+    out.resize(pixels);
+    for (size_t i = 0; i < pixels; ++i) {
+      double n = 0.0;
+      for (const Input& in : inputs) n += samples(in, i);
+      out[i] = float(n);
+    }
+  }
+  // The variance of the union's mean from each input's mean m and variance of the mean v over n
+  // samples, which give back its sum of squares Q = (n - 1) n v + n m^2; the union's variance of
+  // the mean is (sum Q - N M^2) / ((N - 1) N) with N = sum n and M the merged mean.
+  const auto mergeVariance = [&](const std::vector<const std::vector<float>*>& vars,
+                                 const std::string& colour, std::vector<float>& out) {
+    out.resize(pixels);
+    for (size_t i = 0; i < pixels; ++i) {
+      double q = 0.0, n = 0.0;
+      for (size_t k = 0; k < inputs.size(); ++k) {
+        const double nk = samples(inputs[k], i), m = inputs[k].exr.channels.at(colour)[i];
+        q += (nk - 1.0) * nk * double((*vars[k])[i]) + nk * m * m;
+        n += nk;
+      }
+      const double mean = merged.at(colour)[i];
+      out[i] = n > 1.0 ? float(std::max(0.0, (q - n * mean * mean) / ((n - 1.0) * n))) : 0.0f;
+    }
+  };
+  for (const char* c : {"R", "G", "B"})
+    if (base.exr.has(std::string("variance.") + c)) {
+      std::vector<const std::vector<float>*> vars;
+      for (const Input& in : inputs) vars.push_back(&in.exr.channels.at(std::string("variance.") + c));
+      mergeVariance(vars, c, merged[std::string("variance.") + c]);
+    }
+  Image out(width, height);
+  for (size_t i = 0; i < pixels; ++i)
+    for (int c = 0; c < 3; ++c) out.rgb[3 * i + size_t(c)] = merged.at(std::string(1, "RGB"[c]))[i];
+  std::vector<ImageLayer> layers;
+  for (const auto& [name, data] : merged)
+    if (name != "R" && name != "G" && name != "B") layers.push_back({{name}, data});
   std::string ranges;
   for (const Input* in : order)
     ranges +=
@@ -120,30 +192,27 @@ int runMerge(const MergeArgs& a) {
   meta.emplace_back("ember:sample_ranges", ranges);
   meta.emplace_back("Software", std::string("ember ") + EMBER_VERSION + " merge");
   if (!a.variances.empty()) {
-    // Each input's mean m and variance of the mean v over n samples give back its sum of squares,
-    // Q = (n - 1) n v + n m^2; the union's variance of the mean is then
-    // (sum Q - N M^2) / ((N - 1) N) with N = sum n and M the merged mean.
     std::vector<Image> vars;
     for (size_t k = 0; k < a.variances.size(); ++k) {
       vars.push_back(readImageRgb(a.variances[k]));
-      if (vars.back().width != base.image.width || vars.back().height != base.image.height)
+      if (vars.back().width != width || vars.back().height != height)
         throw InputError(a.variances[k] + ": its size differs from " + inputs[k].path + "'s");
     }
-    Image var(base.image.width, base.image.height);
-    const double total_ = double(total);
-    for (size_t i = 0; i < var.rgb.size(); ++i) {
-      double q = 0.0;
-      for (size_t k = 0; k < inputs.size(); ++k) {
-        const double n = double(inputs[k].spp), m = inputs[k].image.rgb[i];
-        q += (n - 1.0) * n * double(vars[k].rgb[i]) + n * m * m;
+    Image var(width, height);
+    for (int c = 0; c < 3; ++c) {
+      std::vector<std::vector<float>> channel(vars.size(), std::vector<float>(pixels));
+      std::vector<const std::vector<float>*> pointers;
+      for (size_t k = 0; k < vars.size(); ++k) {
+        for (size_t i = 0; i < pixels; ++i) channel[k][i] = vars[k].rgb[3 * i + size_t(c)];
+        pointers.push_back(&channel[k]);
       }
-      const double mean = out.rgb[i];
-      var.rgb[i] =
-          total > 1 ? float(std::max(0.0, (q - total_ * mean * mean) / ((total_ - 1.0) * total_))) : 0.0f;
+      std::vector<float> merged_;
+      mergeVariance(pointers, std::string(1, "RGB"[c]), merged_);
+      for (size_t i = 0; i < pixels; ++i) var.rgb[3 * i + size_t(c)] = merged_[i];
     }
     writeExr(a.varianceOutput, var, meta);
   }
-  writeExr(a.output, out, meta);
+  writeExr(a.output, out, layers, meta);
   std::fprintf(stderr, "ember: merged %zu images, %llu spp (samples %s) -> %s\n", inputs.size(),
                static_cast<unsigned long long>(total), ranges.c_str(), a.output.c_str());
   return 0;

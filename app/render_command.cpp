@@ -46,6 +46,7 @@ struct RenderArgs {
   std::string variant;
   std::string textureFilter;
   std::optional<double> untilRelerr;
+  std::string aovs;
   bool quiet = false;
   std::string checkpoint, resume, time;
   double checkpointEvery = 60.0;
@@ -182,6 +183,7 @@ RenderSetup setUp(RenderArgs& a) {
                                                    {!a.textureFilter.empty(), "--texture-filter"},
                                                    {a.camera >= 0, "--camera"},
                                                    {a.firstSample != 0, "--first-sample"},
+                                                   {!a.aovs.empty(), "--aov"},
                                                    {a.passSpp.has_value(), "--pass-spp"}})
       if (given)
         throw InputError(std::string("--resume takes the render's settings from its checkpoint; ") + name +
@@ -271,6 +273,11 @@ int runRender(RenderArgs a) {
   checkOutputPath(a.output, ".exr", "-o");
   Scene& scene = setup.scene;
   const RenderSettings& s = scene.settings;
+  std::string aovError;
+  const AovSet aovs = setup.resumed    ? setup.resumed->film.aovs()
+                      : a.aovs.empty() ? AovSet{}
+                                       : parseAovs(a.aovs, aovError).value();  // CLI11 checked it
+  scene.uvOnEveryHit = aovs.has(Aov::Uv);
   scene.build();
   if (a.packetWidth != "auto") scene.setPacketWidth(unsigned(std::stoi(a.packetWidth)));
   if (const std::string w = unreachableLightsWarning(scene, s.strategy); !w.empty())
@@ -278,7 +285,7 @@ int runRender(RenderArgs a) {
   const double loadSeconds = std::chrono::duration<double>(Clock::now() - loadStart).count();
 
   const std::unique_ptr<Integrator> integrator = makeIntegrator(s, *parseKernel(a.kernel));
-  Film film = setup.resumed ? std::move(setup.resumed->film) : Film(s.width, s.height);
+  Film film = setup.resumed ? std::move(setup.resumed->film) : Film(s.width, s.height, aovs);
   // This process's samples: all of them, or under MPI its rank's share of every pixel's (a resumed
   // rank's share is in its own checkpoint).
   uint64_t first = setup.firstSample;
@@ -360,13 +367,14 @@ int runRender(RenderArgs a) {
                 {"ember:version", EMBER_VERSION},
                 {"DateTime", isoTime()},
                 {"Software", std::string("ember ") + EMBER_VERSION}};
+  if (!film.aovs().empty()) meta.push_back({"ember:aovs", aovList(film.aovs())});
   if (a.untilRelerr) {
     meta.push_back({"ember:until_relerr", std::to_string(*a.untilRelerr)});
     meta.push_back({"ember:relerr", std::to_string(stats.relativeError)});
   }
   if (sppDone > 0) {
     const Image image = film.mean();
-    writeExr(a.output, image, meta);
+    writeExr(a.output, image, film.aovLayers(), meta);
     if (!a.variance.empty()) writeExr(a.variance, film.varianceOfMean(), meta);
     if (!a.png.empty()) {
       const ReinhardResult tm = tonemapReinhard(image, ReinhardParams{});
@@ -478,6 +486,15 @@ Runner addRenderCommand(CLI::App& app) {
                        : "expected a positive number, got '" + v + "'";
           },
           "POSITIVE"));
+  cmd->add_option("--aov", args->aovs,
+                  std::string("Also write these layers into the EXR, comma-separated (docs/aovs.md): ") +
+                      kAovNames + "; or all. Albedo and normal are the denoiser's guides")
+      ->check(CLI::Validator(
+          [](std::string& v) {
+            std::string error;
+            return parseAovs(v, error) ? std::string() : error;
+          },
+          "LIST"));
   cmd->add_option("--texture-filter", args->textureFilter,
                   "glTF files: how their images are filtered: bilinear (the default; nearest where a sampler "
                   "asks) or trilinear (MIP-mapped over each hit's pixel footprint through OpenImageIO: less "

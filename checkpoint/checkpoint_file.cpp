@@ -92,6 +92,7 @@ void writeCheckpoint(const std::string& path, const Checkpoint& c) {
                                  {"pass_spp", c.passSpp},
                                  {"passes", c.passes},
                                  {"output", c.output},
+                                 {"aovs", aovList(c.film.aovs())},
                                  {"ember_version", c.emberVersion}};
   const std::string text = header.dump();
   std::string bytes(kMagic, sizeof kMagic);
@@ -101,6 +102,7 @@ void writeCheckpoint(const std::string& path, const Checkpoint& c) {
   putArray(bytes, c.film.sums());
   putArray(bytes, c.film.sumsOfSquares());
   putArray(bytes, c.film.counts());
+  putArray(bytes, c.film.aovSums());
   put(bytes, uint64_t(XXH3_64bits(bytes.data(), bytes.size())));
 
   writeAtomically(path, [&](const std::string& tmp) { writeFileDurably(tmp, bytes); });
@@ -133,6 +135,7 @@ Checkpoint readCheckpoint(const std::string& path) {
   const nlohmann::json header = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (!header.is_object()) throw InputError(path + ": corrupted checkpoint header (not JSON)");
   Checkpoint c;
+  AovSet aovs;
   try {
     c.identity = RenderIdentity::fromJson(header.at("identity"), path);
     c.firstSample = header.at("first_sample").get<uint64_t>();
@@ -141,6 +144,10 @@ Checkpoint readCheckpoint(const std::string& path) {
     c.passes = header.at("passes").get<int>();
     c.output = header.at("output").get<std::string>();
     c.emberVersion = header.at("ember_version").get<std::string>();
+    std::string error;
+    const std::optional<AovSet> parsed = parseAovs(header.at("aovs").get<std::string>(), error);
+    if (!parsed) throw InputError(path + ": corrupted checkpoint header (" + error + ")");
+    aovs = *parsed;
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {
@@ -148,13 +155,14 @@ Checkpoint readCheckpoint(const std::string& path) {
   }
   if (c.spp < 1 || c.passSpp < 1 || c.passes < 0 || c.passes > passCount(c.spp, c.passSpp))
     throw InputError(path + ": corrupted checkpoint header (inconsistent sample counts)");
-  c.film = Film(c.identity.width, c.identity.height);
+  c.film = Film(c.identity.width, c.identity.height, aovs);
   r.getArray(c.film.sums(), "sums");
   r.getArray(c.film.sumsOfSquares(), "sums of squares");
   r.getArray(c.film.counts(), "counts");
+  r.getArray(c.film.aovSums(), "AOV sums");
   if (r.offset() + sizeof(uint64_t) != bytes.size())
     throw InputError(path + ": corrupted checkpoint (" + std::to_string(bytes.size() - r.offset() - 8) +
-                     " unexpected bytes after the counts)");
+                     " unexpected bytes after the AOV sums)");
   const uint32_t expected = uint32_t(std::min(c.spp, c.passes * c.passSpp));
   for (uint32_t n : c.film.counts())
     if (n > expected)

@@ -10,6 +10,8 @@
 //   sums                    width * height * 3 doubles (Film::sums)
 //   sums of squares         width * height * 3 doubles
 //   counts                  width * height u32
+//   AOV sums                width * height * AovLayout(aovs).channels doubles (Film::aovSums), the
+//                           set named in the header's "aovs"
 //   u64 XXH3-64             of every byte before it
 // A file is written to a temporary name beside the target, flushed to disk, then renamed over it:
 // a reader, or a render killed at any moment, sees the previous checkpoint or the new one, whole.
@@ -23,7 +25,7 @@
 
 namespace ember {
 
-inline constexpr uint32_t kCheckpointFormat = 1;
+inline constexpr uint32_t kCheckpointFormat = 2;
 
 struct Checkpoint {
   RenderIdentity identity;

@@ -67,15 +67,21 @@ void Cluster::reduceToRoot(Film& film) const {
     MPI_Send(film.sums().data(), 3 * n, MPI_DOUBLE, 0, 0, MPI_COMM_WORLD);
     MPI_Send(film.sumsOfSquares().data(), 3 * n, MPI_DOUBLE, 0, 1, MPI_COMM_WORLD);
     MPI_Send(film.counts().data(), n, MPI_UINT32_T, 0, 2, MPI_COMM_WORLD);
+    if (!film.aovSums().empty())
+      MPI_Send(film.aovSums().data(), int(film.aovSums().size()), MPI_DOUBLE, 0, 3, MPI_COMM_WORLD);
     return;
   }
   const size_t pixels = static_cast<size_t>(n);
   std::vector<glm::dvec3> sums(pixels), squares(pixels);
   std::vector<uint32_t> counts(pixels);
+  std::vector<double> aovs(film.aovSums().size());
   for (int r = 1; r < size_; ++r) {
     MPI_Recv(sums.data(), 3 * n, MPI_DOUBLE, r, 0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
     MPI_Recv(squares.data(), 3 * n, MPI_DOUBLE, r, 1, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
     MPI_Recv(counts.data(), n, MPI_UINT32_T, r, 2, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    if (!aovs.empty())
+      MPI_Recv(aovs.data(), int(aovs.size()), MPI_DOUBLE, r, 3, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    for (size_t i = 0; i < aovs.size(); ++i) film.aovSums()[i] += aovs[i];
     for (size_t i = 0; i < pixels; ++i) {
       film.sums()[i] += sums[i];
       film.sumsOfSquares()[i] += squares[i];

@@ -342,19 +342,35 @@ Metadata readStringMetadata(const std::string& path) {
 }
 
 void writeExr(const std::string& path, const Image& image, const Metadata& metadata) {
+  writeExr(path, image, {}, metadata);
+}
+
+void writeExr(const std::string& path, const Image& image, const std::vector<ImageLayer>& layers,
+              const Metadata& metadata) {
+  const size_t pixels = size_t(image.width) * size_t(image.height);
+  for (const ImageLayer& layer : layers)
+    if (layer.pixels.size() != pixels * layer.channels.size())
+      throw std::invalid_argument(path + ": layer " + layer.channels.front() + " has the wrong size");
   writeAtomically(path, [&](const std::string& tmp) {
     try {
       Imf::Header header(image.width, image.height);
       header.compression() = Imf::ZIP_COMPRESSION;
-      for (const char* name : {"R", "G", "B"}) header.channels().insert(name, Imf::Channel(Imf::FLOAT));
       for (const auto& [key, value] : metadata) header.insert(key, Imf::StringAttribute(value));
       Imf::FrameBuffer frame;
-      const size_t xStride = 3 * sizeof(float), yStride = xStride * size_t(image.width);
       // OpenEXR's slices take a non-const base pointer, but an output file only reads through it.
-      char* base = reinterpret_cast<char*>(const_cast<float*>(image.rgb.data()));
-      frame.insert("R", Imf::Slice(Imf::FLOAT, base, xStride, yStride));
-      frame.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xStride, yStride));
-      frame.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xStride, yStride));
+      const auto add = [&](const std::string& name, const float* first, size_t stride) {
+        if (header.channels().findChannel(name))
+          throw std::invalid_argument("two layers write channel " + name);
+        header.channels().insert(name, Imf::Channel(Imf::FLOAT));
+        char* base = reinterpret_cast<char*>(const_cast<float*>(first));
+        frame.insert(name, Imf::Slice(Imf::FLOAT, base, stride * sizeof(float),
+                                      stride * sizeof(float) * size_t(image.width)));
+      };
+      const char* rgb[] = {"R", "G", "B"};
+      for (size_t c = 0; c < 3; ++c) add(rgb[c], image.rgb.data() + c, 3);
+      for (const ImageLayer& layer : layers)
+        for (size_t c = 0; c < layer.channels.size(); ++c)
+          add(layer.channels[c], layer.pixels.data() + c, layer.channels.size());
       Imf::OutputFile file(tmp.c_str(), header);
       file.setFrameBuffer(frame);
       file.writePixels(image.height);
@@ -362,6 +378,42 @@ void writeExr(const std::string& path, const Image& image, const Metadata& metad
       throw std::runtime_error(path + ": cannot write EXR: " + e.what());
     }
   });
+}
+
+ExrChannels readExrChannels(const std::string& path) {
+  checkExists(path);
+  if (!Imf::isOpenExrFile(path.c_str())) throw InputError(path + ": not an OpenEXR file");
+  try {
+    limitOpenExr();
+    checkExrAttributeSizes(path);
+    Imf::InputFile file(path.c_str());
+    const Imath::Box2i window = file.header().dataWindow();
+    const int64_t width = int64_t(window.max.x) - window.min.x + 1,
+                  height = int64_t(window.max.y) - window.min.y + 1;
+    checkSize(path, width, height);
+    ExrChannels out;
+    out.width = int(width);
+    out.height = int(height);
+    Imf::FrameBuffer frame;
+    for (auto it = file.header().channels().begin(); it != file.header().channels().end(); ++it) {
+      if (it.channel().xSampling != 1 || it.channel().ySampling != 1)
+        throw InputError(path + ": channel " + it.name() + " is subsampled; Ember reads whole channels");
+      std::vector<float>& data = out.channels[it.name()];
+      data.resize(size_t(width) * size_t(height));
+      frame.insert(it.name(), Imf::Slice::Make(Imf::FLOAT, data.data(), window, sizeof(float),
+                                               sizeof(float) * size_t(width)));
+    }
+    file.setFrameBuffer(frame);
+    file.readPixels(window.min.y, window.max.y);
+    for (auto it = file.header().begin(); it != file.header().end(); ++it)
+      if (const auto* a = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
+        out.metadata.emplace_back(it.name(), a->value());
+    return out;
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw InputError(path + ": cannot read image: " + e.what());
+  }
 }
 
 void writePng(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb8) {

@@ -9,6 +9,7 @@
 #include "renderer/film.h"
 
 #include <cstdint>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -35,6 +36,18 @@ Image readImageRgb(const std::string& path);
 
 using Metadata = std::vector<std::pair<std::string, std::string>>;
 void writeExr(const std::string& path, const Image& image, const Metadata& metadata = {});
+// A multilayer EXR: the colour as R, G, B and each layer's channels under their own names.
+void writeExr(const std::string& path, const Image& image, const std::vector<ImageLayer>& layers,
+              const Metadata& metadata);
+// Every channel of an EXR by name (width * height floats each), and its string attributes; an
+// InputError naming the file for anything else.
+struct ExrChannels {
+  int width = 0, height = 0;
+  std::map<std::string, std::vector<float>> channels;
+  Metadata metadata;
+  bool has(const std::string& name) const { return channels.count(name) != 0; }
+};
+ExrChannels readExrChannels(const std::string& path);
 // The string attributes of an EXR's header (its ember:* metadata); none for other formats.
 Metadata readStringMetadata(const std::string& path);
 void writePng(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb8);

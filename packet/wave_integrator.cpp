@@ -43,6 +43,8 @@ struct Wave {
   Row<int> x, y, sample;
   std::vector<Sampler> samplers = std::vector<Sampler>(kSize, Sampler(SamplerType::Independent, 0, 0, 0));
   Row<Color> radiance;
+  // Each camera sample's AOVs (renderer/aov.h), when the film has any.
+  Row<AovSample> aov;
   // Paths in flight: the ray cast and what its next vertex needs.
   PathArrays paths;
   // Vertices: NextEventArrays holds their points, normals, errors, directions back, reflectances
@@ -168,6 +170,7 @@ void WaveIntegrator::renderTile(const Scene& scene, const TileWork& work, Film& 
   const LightSampler& lights = scene.lightSampler();
   const RequestUse lightUse{lights.size() > 1, lights.deltaLightCount() < lights.size()};
   const int maxDepth = path_.maxDepth(), rrDepth = path_.rrDepth();
+  const bool aovs = film.aovs().perSample();
 
   // Camera sample k of the tile is pixel k % pixels (row by row) of sample k / pixels; the wave
   // steps through them in that order, counting instead of dividing.
@@ -192,6 +195,7 @@ void WaveIntegrator::renderTile(const Scene& scene, const TileWork& work, Film& 
     PathArrays& paths = wave.paths;
     ContinuationArrays& cont = wave.cont;
     std::fill_n(wave.radiance.begin(), count, Color(0.0f));
+    if (aovs) std::fill_n(wave.aov.begin(), count, AovSample{});
     size_t active = maxDepth == 0 ? 0 : count;  // camera sample i is slot i
     const Camera& camera = scene.camera();
     if (camera.perspective()) {
@@ -253,6 +257,8 @@ void WaveIntegrator::renderTile(const Scene& scene, const TileWork& work, Film& 
         const int32_t owner = paths.owner[s];
         RawHit raw;
         if (!wave.closest.hit(s, raw)) {
+          if (aovs && !wave.aov[size_t(owner)].surfaceFound)
+            PathIntegrator::aovOnMiss(scene, gather(s), wave.aov[size_t(owner)]);
           if (!PathIntegrator::missAddsLight(scene)) return;  // no state to gather
           PathState path = gather(s);
           path_.onMiss(scene, path);
@@ -265,6 +271,7 @@ void WaveIntegrator::renderTile(const Scene& scene, const TileWork& work, Film& 
         PathIntegrator::widenFootprint(scene, path, hit);
         const bool scatters = path_.arrive(scene, path, hit, stats);
         wave.radiance[size_t(owner)] = path.radiance;
+        if (aovs) PathIntegrator::aovOnArrival(path, hit, scatters, wave.aov[size_t(owner)]);
         if (!scatters) return;
         const size_t v = vertices++;
         Color reflectance;
@@ -301,7 +308,14 @@ void WaveIntegrator::renderTile(const Scene& scene, const TileWork& work, Film& 
         const Color* albedo = rec && rec->shape && rec->material && isBlack(rec->emission)
                                   ? rec->material->uniformLambertian()
                                   : nullptr;
-        if (maxDepth >= 0 || !albedo || isBlack(*albedo)) {
+        // A camera sample still looking for its AOVs' vertex takes the general steps, which record
+        // them (the image is the same either way).
+        const auto seeksAovs = [&] {
+          for (size_t j = 0; j < count; ++j)
+            if (!wave.aov[size_t(paths.owner[slots[j]])].surfaceFound) return true;
+          return false;
+        };
+        if (maxDepth >= 0 || !albedo || isBlack(*albedo) || (aovs && seeksAovs())) {
           for (size_t o = run.begin; o < run.end; ++o) arriveOne(o);
           continue;
         }
@@ -434,6 +448,19 @@ void WaveIntegrator::renderTile(const Scene& scene, const TileWork& work, Film& 
         cont.eta[v] = bs.eta;
         cont.sampledDelta[v] = bs.delta ? -1 : 0;
       }
+      if (aovs)
+        for (size_t v = 0; v < vertices; ++v) {
+          AovSample& aov = wave.aov[size_t(cont.owner[v])];
+          if (!aov.surfaceFound || aov.albedoKnown) continue;
+          if (wave.general[v]) {
+            PathIntegrator::aovOnSample(cont.generalSampled[v] != 0, load3(cont.weight, v), aov);
+          } else {  // Lambertian::sample's test, and its weight: the reflectance
+            const Vec3 ng = load3(nee.ng, v), wi = load3(cont.wi, v);
+            const bool sampled =
+                !(cont.pdf[v] <= 0.0f) && glm::dot(load3(nee.wo, v), ng) * glm::dot(wi, ng) > 0.0f;
+            PathIntegrator::aovOnSample(sampled, load3(nee.albedo, v), aov);
+          }
+        }
       const size_t next = continuationLanes(nee, cont, vertices, rrDepth, paths);
       wave.closest.assign(rowsOf(paths.origin), rowsOf(paths.dir), paths.mask, next);
       phases.mark(PathPhase::Continuation);
@@ -448,8 +475,12 @@ void WaveIntegrator::renderTile(const Scene& scene, const TileWork& work, Film& 
       phases.mark(PathPhase::TraceShadows);
     }
 
-    for (size_t i = 0; i < count; ++i)
-      addToFilm(film, work, wave.x[i], wave.y[i], wave.sample[i], wave.radiance[i], stats);
+    if (aovs)
+      for (size_t i = 0; i < count; ++i)
+        addToFilm(film, work, wave.x[i], wave.y[i], wave.sample[i], wave.radiance[i], wave.aov[i], stats);
+    else
+      for (size_t i = 0; i < count; ++i)
+        addToFilm(film, work, wave.x[i], wave.y[i], wave.sample[i], wave.radiance[i], stats);
     phases.mark(PathPhase::Camera);
   }
 }

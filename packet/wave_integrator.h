@@ -41,6 +41,10 @@ class WaveIntegrator final : public Integrator {
   Color Li(const Scene& scene, Ray ray, Sampler& sampler, PathStats& stats) const override {
     return path_.Li(scene, ray, sampler, stats);
   }
+  Color LiWithAovs(const Scene& scene, Ray ray, Sampler& sampler, PathStats& stats,
+                   AovSample& aov) const override {
+    return path_.LiWithAovs(scene, ray, sampler, stats, aov);
+  }
   void renderTile(const Scene& scene, const TileWork& work, Film& film, PathStats& stats) const override;
   bool tracesCaustics() const override { return path_.tracesCaustics(); }
   // The light paths in waves too (packet/caustic_wave.h).

@@ -4,8 +4,10 @@
 #pragma once
 
 #include "core/math.h"
+#include "renderer/aov.h"
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace ember {
@@ -30,9 +32,17 @@ struct Image {
   }
 };
 
+// Named channels of one image, interleaved pixel by pixel: a layer of a multilayer EXR
+// ("albedo" with channels albedo.R, albedo.G, albedo.B; or Z alone).
+struct ImageLayer {
+  std::vector<std::string> channels;
+  std::vector<float> pixels;  // width * height * channels.size()
+};
+
 class Film {
  public:
-  Film(int width, int height);
+  // With AOVs (renderer/aov.h), their per-sample values are summed beside the colour's.
+  Film(int width, int height, AovSet aovs = {});
 
   // Not thread-safe per pixel; the renderer gives every pixel to exactly one task.
   void addSample(int x, int y, const Color& L) {
@@ -41,6 +51,11 @@ class Film {
     sum_[i] += d;
     sumSq_[i] += d * d;
     ++count_[i];
+  }
+  // The same with the sample's AOVs, for a film that has them.
+  void addSample(int x, int y, const Color& L, const AovSample& aov) {
+    addSample(x, y, L);
+    if (layout_.channels) addAovs(size_t(y) * size_t(width_) + size_t(x), aov);
   }
 
   int width() const { return width_; }
@@ -54,6 +69,14 @@ class Film {
   // self, from the film's own variance. Infinite while some pixel holds fewer than 2 samples.
   double relativeError() const;
 
+  AovSet aovs() const { return aovs_; }
+  const AovLayout& aovLayout() const { return layout_; }
+  // The AOV layers of the set, in renderer/aov.h's order, with their EXR channel names
+  // (docs/aovs.md): per-sample AOVs are means over the pixel's samples (depth, position and uv over
+  // those whose camera ray hit a surface; +inf depth where none did), variance the variance of the
+  // colour's mean, spp the pixel's sample count.
+  std::vector<ImageLayer> aovLayers() const;
+
   // The accumulation state itself, pixel by pixel (checkpoint files store and restore it exactly).
   size_t pixelCount() const { return count_.size(); }
   std::vector<glm::dvec3>& sums() { return sum_; }
@@ -62,20 +85,28 @@ class Film {
   const std::vector<glm::dvec3>& sums() const { return sum_; }
   const std::vector<glm::dvec3>& sumsOfSquares() const { return sumSq_; }
   const std::vector<uint32_t>& counts() const { return count_; }
+  // The AOVs' sums: aovLayout().channels doubles per pixel.
+  std::vector<double>& aovSums() { return aovSum_; }
+  const std::vector<double>& aovSums() const { return aovSum_; }
 
   // The state of the pixels [x0, x1) x [y0, y1), saved before a tile adds a pass so that an
   // interrupted pass can be taken back exactly (renderer/render.cpp).
   struct TileBackup {
     std::vector<glm::dvec3> sum, sumSq;
     std::vector<uint32_t> count;
+    std::vector<double> aov;
   };
   void save(int x0, int y0, int x1, int y1, TileBackup& backup) const;
   void restore(int x0, int y0, int x1, int y1, const TileBackup& backup);
 
  private:
+  void addAovs(size_t pixel, const AovSample& aov);
   int width_, height_;
   std::vector<glm::dvec3> sum_, sumSq_;
   std::vector<uint32_t> count_;
+  AovSet aovs_;
+  AovLayout layout_;
+  std::vector<double> aovSum_;
 };
 
 }  // namespace ember

@@ -22,6 +22,16 @@ void addToFilm(Film& film, const TileWork& work, int x, int y, int s, const Colo
   addToFilm(film, x, y, work.caustics ? L + work.caustics->at(s, x, y) : L, stats);
 }
 
+void addToFilm(Film& film, const TileWork& work, int x, int y, int s, const Color& L, const AovSample& aov,
+               PathStats& stats) {
+  const Color total = work.caustics ? L + work.caustics->at(s, x, y) : L;
+  if (isFinite(total)) {
+    film.addSample(x, y, total, aov);
+  } else {
+    ++stats.nonFinite;
+  }
+}
+
 void Integrator::traceCaustics(const Scene& scene, uint64_t seed, SamplerType sampler, uint64_t firstIndex,
                                int count, CausticSplats& splats, PathStats& stats) const {
   scene.causticTracer().traceAlone(scene, maxDepth(), rrDepth(), seed, sampler, firstIndex, count, splats,
@@ -36,7 +46,13 @@ void Integrator::renderTile(const Scene& scene, const TileWork& work, Film& film
       for (int s = 0; s < work.spp; ++s) {
         Sampler sampler(work.sampler, work.seed, pixel, work.firstSample + uint64_t(s));
         const Ray ray = cameraRay(scene, x, y, sampler);
-        addToFilm(film, work, x, y, s, Li(scene, ray, sampler, stats), stats);
+        if (film.aovs().perSample()) {
+          AovSample aov;
+          const Color L = LiWithAovs(scene, ray, sampler, stats, aov);
+          addToFilm(film, work, x, y, s, L, aov, stats);
+        } else {
+          addToFilm(film, work, x, y, s, Li(scene, ray, sampler, stats), stats);
+        }
       }
     }
 }

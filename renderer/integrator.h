@@ -53,6 +53,12 @@ class Integrator {
  public:
   virtual ~Integrator() = default;
   virtual Color Li(const Scene& scene, Ray ray, Sampler& sampler, PathStats& stats) const = 0;
+  // The same, recording the sample's AOVs (renderer/aov.h) into `aov`; an estimator that has none
+  // leaves it as it was.
+  virtual Color LiWithAovs(const Scene& scene, Ray ray, Sampler& sampler, PathStats& stats,
+                           AovSample& /*aov*/) const {
+    return Li(scene, ray, sampler, stats);
+  }
 
   // Adds every sample of the tile to the film. Each (pixel, sample index) has its own sampler,
   // and a pixel's samples reach the film in the order of their indices, so any implementation
@@ -82,5 +88,8 @@ Ray cameraRay(const Scene& scene, int x, int y, Vec2 jitter);
 void addToFilm(Film& film, int x, int y, const Color& L, PathStats& stats);
 // The same for sample s of the tile's pass, with the light tracer's splat for it added.
 void addToFilm(Film& film, const TileWork& work, int x, int y, int s, const Color& L, PathStats& stats);
+// The same with the sample's AOVs, for a film that has them (dropped with a non-finite colour).
+void addToFilm(Film& film, const TileWork& work, int x, int y, int s, const Color& L, const AovSample& aov,
+               PathStats& stats);
 
 }  // namespace ember

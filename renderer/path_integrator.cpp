@@ -70,6 +70,7 @@ bool PathIntegrator::start(const Ray& cameraRay, PathState& path) const {
 }
 
 void PathIntegrator::onMiss(const Scene& scene, PathState& path) const {
+  if (path.aov) aovOnMiss(scene, path, *path.aov);
   if (const EnvironmentLight* env = scene.environment()) {
     float weight = 1.0f;
     if (!path.previousDelta)
@@ -93,7 +94,9 @@ void PathIntegrator::widenFilteredFootprint(const Scene& scene, const PathState&
 bool PathIntegrator::onHit(const Scene& scene, PathState& path, const SurfaceHit& hit, Sampler& sampler,
                            PathStats& stats, ShadowRequest& shadow, bool& continues) const {
   continues = false;
-  if (!arrive(scene, path, hit, stats)) return false;
+  const bool scatters = arrive(scene, path, hit, stats);
+  if (path.aov) aovOnArrival(path, hit, scatters, *path.aov);
+  if (!scatters) return false;
   LightPick pick;
   bool hasShadow = false;
   if (pickLight(scene, hit, sampler, pick)) {
@@ -142,6 +145,7 @@ bool PathIntegrator::scatter(PathState& path, const SurfaceHit& hit, Sampler& sa
   drawBsdfSample(sampler, u, uLobe);
   BsdfSample bs;
   const bool sampled = hit.material->sample(hit, -path.ray.dir, u, uLobe, bs);
+  if (path.aov) aovOnSample(sampled, bs.weight, *path.aov);
   return followBsdfSample(path, hit, bs, sampled, sampler);
 }
 
@@ -168,9 +172,64 @@ bool PathIntegrator::followBsdfSample(PathState& path, const SurfaceHit& hit, co
   return true;
 }
 
+namespace {
+
+Color clamp01(const Color& c) {
+  return glm::clamp(c, Color(0.0f), Color(1.0f));
+}
+
+}  // namespace
+
+void PathIntegrator::aovOnArrival(const PathState& path, const SurfaceHit& hit, bool scatters,
+                                  AovSample& aov) {
+  if (path.depth == 1) {
+    aov.hit = true;
+    aov.position = hit.p;
+    aov.depth = glm::length(hit.p - path.ray.origin);
+    aov.uv = hit.uv;
+  }
+  if (aov.surfaceFound) return;
+  // A Dirac-only surface is followed through to what it shows.
+  if (scatters && !hit.material->hasNonDeltaLobes()) return;
+  const Vec3 wo = -path.ray.dir;
+  aov.surfaceFound = true;
+  aov.normal = hit.material ? facingNormal(hit, wo) : (glm::dot(wo, hit.ng) >= 0.0f ? hit.ng : -hit.ng);
+  aov.albedo = clamp01(path.throughput);
+  if (scatters) return;  // the BSDF sample gives the rest (aovOnSample)
+  // A surface without a material is an emitter alone: its colour stands for its albedo. A vertex
+  // that absorbs everything, or ends the path at the depth limit, has none.
+  aov.albedo = hit.material ? Color(0.0f) : aov.albedo * clamp01(hit.emitted(wo));
+  aov.albedoKnown = true;
+}
+
+void PathIntegrator::aovOnSample(bool sampled, const Color& weight, AovSample& aov) {
+  if (!aov.surfaceFound || aov.albedoKnown) return;
+  aov.albedo = sampled ? aov.albedo * clamp01(weight) : Color(0.0f);
+  aov.albedoKnown = true;
+}
+
+void PathIntegrator::aovOnMiss(const Scene& scene, const PathState& path, AovSample& aov) {
+  if (aov.surfaceFound) return;
+  aov.surfaceFound = aov.albedoKnown = true;
+  const EnvironmentLight* env = scene.environment();
+  aov.albedo = env ? clamp01(path.throughput) * clamp01(env->radiance(path.ray.dir)) : Color(0.0f);
+}
+
+Color PathIntegrator::LiWithAovs(const Scene& scene, Ray ray, Sampler& sampler, PathStats& stats,
+                                 AovSample& aov) const {
+  PathState path;
+  if (!start(ray, path)) return path.radiance;
+  path.aov = &aov;
+  return trace(scene, path, sampler, stats);
+}
+
 Color PathIntegrator::Li(const Scene& scene, Ray ray, Sampler& sampler, PathStats& stats) const {
   PathState path;
   if (!start(ray, path)) return path.radiance;
+  return trace(scene, path, sampler, stats);
+}
+
+Color PathIntegrator::trace(const Scene& scene, PathState& path, Sampler& sampler, PathStats& stats) const {
   for (;;) {
     SurfaceHit hit;
     ++stats.rays;

@@ -44,6 +44,9 @@ struct PathState {
   uint32_t rayMask = kAllRayMask;
   int depth = 1;                     // segments cast so far, counting the one in flight
   bool firstBounceNonDelta = false;  // the camera vertex scattered through a non-Dirac lobe
+  // Where the sample's AOVs go (renderer/aov.h), for the one-path-at-a-time steps (Li, onHit,
+  // scatter, onMiss); null when the render asks for none. The batched driver keeps its own.
+  AovSample* aov = nullptr;
 };
 
 // Next-event estimation's shadow ray: if nothing blocks it, `contribution` (throughput included)
@@ -77,6 +80,8 @@ class PathIntegrator final : public Integrator {
 
   // The scalar reference: casts each ray of the path alone, as soon as it is known.
   Color Li(const Scene& scene, Ray ray, Sampler& sampler, PathStats& stats) const override;
+  Color LiWithAovs(const Scene& scene, Ray ray, Sampler& sampler, PathStats& stats,
+                   AovSample& aov) const override;
 
   // The path as a state machine, for Li and for loops that cast the rays of many paths together
   // (packet/wave_integrator.h). Both call the same steps in the same order per path, so
@@ -128,10 +133,25 @@ class PathIntegrator final : public Integrator {
   bool followBsdfSample(PathState& path, const SurfaceHit& hit, const BsdfSample& bs, bool sampled,
                         Sampler& sampler) const;
 
+  // The AOVs' steps (docs/aovs.md), taken by both drivers at the same points of a path:
+  //  - on arrival at a hit, after arrive() (`scatters` is what it returned): the camera ray's hit
+  //    gives depth, position and uv; the first vertex with a non-Dirac lobe (or no material, or
+  //    where a Dirac chain ends) gives the normal, and the albedo is then the chain's weight (the
+  //    throughput so far, clamped to [0, 1]) times that vertex's;
+  //  - on the BSDF sample there: the vertex's albedo is the sample's weight f |cos| / pdf, clamped
+  //    to [0, 1] (0 when nothing was sampled): its directional albedo's one-sample estimate, which
+  //    the film's mean makes the albedo itself (for a Lambertian surface, the reflectance exactly);
+  //  - on a miss before that vertex: no normal, and the environment's radiance (clamped) as albedo.
+  static void aovOnArrival(const PathState& path, const SurfaceHit& hit, bool scatters, AovSample& aov);
+  static void aovOnSample(bool sampled, const Color& weight, AovSample& aov);
+  static void aovOnMiss(const Scene& scene, const PathState& path, AovSample& aov);
+
  private:
   // Weight of emission that a BSDF-sampled direction (density bsdfPdf) found, where light sampling
   // would have produced it with density lightPdf.
   float emissionWeight(float bsdfPdf, float lightPdf) const;
+  // Li's loop, from a started path.
+  Color trace(const Scene& scene, PathState& path, Sampler& sampler, PathStats& stats) const;
 
   int maxDepth_;
   int rrDepth_;

@@ -74,7 +74,7 @@ void Scene::build() {
     ShapeEntry& entry = shapes[i];
     // Analytic shapes have no surface maps and AreaLight's radiance is uniform, so the material
     // is the only reader of their UV (were emission textures added, they would read it too).
-    const bool readsUv = !entry.material || entry.material->readsUv();
+    const bool readsUv = uvOnEveryHit || !entry.material || entry.material->readsUv();
     const bool emits = !isBlack(entry.emission);
     const uint32_t ownBit = ownBits[i];
     const uint32_t id = accel_->addShape(entry.shape.get(), readsUv, ownBit ? ownBit : kAllRayMask);

@@ -75,6 +75,9 @@ class Scene {
   float environmentRotateYDeg = 0.0f;
   // Some texture is filtered over the footprint of each hit: surfaceHit then works it out.
   bool filteredTextures = false;
+  // Every hit computes its texture coordinates, as the uv AOV needs (renderer/aov.h); otherwise
+  // hits on analytic shapes whose material reads none skip them. Set before build().
+  bool uvOnEveryHit = false;
   std::vector<std::unique_ptr<Material>> materials;
   std::vector<std::string> materialNames;  // parallel to materials
   // The KHR_materials_variants names of the glTF files loaded (`ember info` lists them).

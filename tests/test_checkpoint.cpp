@@ -247,7 +247,7 @@ TEST(CheckpointFile, CorruptedTruncatedAndForeignFilesAreRejected) {
   expectRejected("", "empty");
   expectRejected("\x89PNG\r\n\x1a\n", "a PNG");
   std::string future = bytes;
-  future[8] = 2;  // format version 2
+  future[8] = char(kCheckpointFormat + 1);  // a format after this one
   expectRejected(future, "a newer format");
   EXPECT_THROW(readCheckpoint(dir.file("missing.ckpt")), InputError);
 }
