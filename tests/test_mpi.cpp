@@ -74,6 +74,34 @@ TEST(Mpi, TwoAndThreeRanksGiveTheSingleProcessImage) {
   }
 }
 
+// The AOV layers are sums like the colour's: the ranks' add up to the single process's.
+TEST(Mpi, AovLayersEqualTheSingleProcessOnes) {
+  test::TempDir dir;
+  const std::string one = dir.file("one.exr"), two = dir.file("two.exr");
+  ASSERT_EQ(test::runEmber("render '" + kScene + "' -o '" + one + "'" + kSettings + " --aov all").exitCode,
+            0);
+  const test::CliResult r = runShell(mpirun(2) + "'" + EMBER_BINARY + "' render '" + kScene + "' -o '" + two +
+                                     "'" + kSettings + " --aov all");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  const ExrChannels a = readExrChannels(one), b = readExrChannels(two);
+  ASSERT_EQ(a.channels.size(), b.channels.size());
+  EXPECT_TRUE(a.has("albedo.R") && a.has("N.X") && a.has("Z") && a.has("spp"));
+  for (const auto& [name, values] : a.channels) {
+    ASSERT_TRUE(b.has(name)) << name;
+    const std::vector<float>& other = b.channels.at(name);
+    for (size_t i = 0; i < values.size(); ++i) {
+      if (!std::isfinite(values[i])) {
+        EXPECT_EQ(values[i], other[i]) << name;
+        continue;
+      }
+      // The variance of the mean is a difference of sums: its rounding is relative to the sums.
+      const double tolerance = name.rfind("variance.", 0) == 0 ? 1e-4 : 1e-6;
+      ASSERT_NEAR(other[i], values[i], tolerance * std::max(1.0, double(std::abs(values[i]))))
+          << name << " " << i;
+    }
+  }
+}
+
 TEST(Mpi, CheckpointedRanksResumeToTheSameImage) {
   test::TempDir dir;
   const std::string out = dir.file("np2.exr"), ckpt = dir.file("job.ckpt");
