@@ -16,5 +16,6 @@ Runner addInfoCommand(CLI::App& app);
 Runner addBenchCommand(CLI::App& app);
 Runner addCompareCommand(CLI::App& app);
 Runner addMergeCommand(CLI::App& app);
+Runner addDenoiseCommand(CLI::App& app);
 
 }  // namespace ember::cli

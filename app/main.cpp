@@ -1,4 +1,5 @@
-// ember: command-line front end. Subcommands live in one file each (render, tonemap, info, bench, compare).
+// ember: command-line front end. Subcommands live in one file each (render, tonemap, info, bench, compare,
+// merge, denoise).
 #include "app/commands.h"
 
 #include "io/input_error.h"
@@ -14,7 +15,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   std::map<CLI::App*, ember::cli::Runner> runners;
   for (auto add : {ember::cli::addRenderCommand, ember::cli::addTonemapCommand, ember::cli::addInfoCommand,
-                   ember::cli::addBenchCommand, ember::cli::addCompareCommand, ember::cli::addMergeCommand}) {
+                   ember::cli::addBenchCommand, ember::cli::addCompareCommand, ember::cli::addMergeCommand,
+                   ember::cli::addDenoiseCommand}) {
     const size_t before = app.get_subcommands({}).size();
     ember::cli::Runner run = add(app);
     runners[app.get_subcommands({})[before]] = std::move(run);

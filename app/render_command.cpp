@@ -2,6 +2,8 @@
 
 #include "app/stop_signals.h"
 #include "checkpoint/checkpoint_file.h"
+#include "denoise/denoiser.h"
+#include "denoise/oidn_library.h"
 #include "distributed/cluster.h"
 #include "io/filtered_texture.h"
 #include "io/image_io.h"
@@ -47,6 +49,7 @@ struct RenderArgs {
   std::string textureFilter;
   std::optional<double> untilRelerr;
   std::string aovs;
+  bool denoise = false;
   bool quiet = false;
   std::string checkpoint, resume, time;
   double checkpointEvery = 60.0;
@@ -268,15 +271,21 @@ int runRender(RenderArgs a) {
   if (!a.variance.empty()) checkOutputPath(a.variance, ".exr", "--variance");
   if (!a.checkpoint.empty()) checkOutputPath(a.checkpoint, ".ckpt", "--checkpoint");
   const double budget = a.time.empty() ? 0.0 : parseDuration(a.time);
+  // Before any work: a denoised render needs the library, and says so with nothing written.
+  if (std::string why; a.denoise && !denoiserAvailable(why)) throw InputError("--denoise: " + why);
 
   RenderSetup setup = setUp(a);
   checkOutputPath(a.output, ".exr", "-o");
   Scene& scene = setup.scene;
   const RenderSettings& s = scene.settings;
   std::string aovError;
-  const AovSet aovs = setup.resumed    ? setup.resumed->film.aovs()
-                      : a.aovs.empty() ? AovSet{}
-                                       : parseAovs(a.aovs, aovError).value();  // CLI11 checked it
+  AovSet aovs = setup.resumed    ? setup.resumed->film.aovs()
+                : a.aovs.empty() ? AovSet{}
+                                 : parseAovs(a.aovs, aovError).value();  // CLI11 checked it
+  if (a.denoise && !setup.resumed) {  // the denoiser's guides
+    aovs.add(Aov::Albedo);
+    aovs.add(Aov::Normal);
+  }
   scene.uvOnEveryHit = aovs.has(Aov::Uv);
   scene.build();
   if (a.packetWidth != "auto") scene.setPacketWidth(unsigned(std::stoi(a.packetWidth)));
@@ -373,8 +382,17 @@ int runRender(RenderArgs a) {
     meta.push_back({"ember:relerr", std::to_string(stats.relativeError)});
   }
   if (sppDone > 0) {
-    const Image image = film.mean();
-    writeExr(a.output, image, film.aovLayers(), meta);
+    Image image = film.mean();
+    std::vector<ImageLayer> layers = film.aovLayers();
+    if (a.denoise) {
+      const auto denoiseStart = Clock::now();
+      layers.insert(layers.begin(), ImageLayer{{"noisy.R", "noisy.G", "noisy.B"}, image.rgb});
+      image.rgb = denoise(denoiseInput(image, layers), DenoiseOptions{a.threads.value_or(0), true});
+      const double seconds = std::chrono::duration<double>(Clock::now() - denoiseStart).count();
+      meta.push_back({"ember:denoiser", denoiserDescription(layers)});
+      std::fprintf(stderr, "ember: denoised in %.3f s (%s)\n", seconds, oidnLibraryPath().c_str());
+    }
+    writeExr(a.output, image, layers, meta);
     if (!a.variance.empty()) writeExr(a.variance, film.varianceOfMean(), meta);
     if (!a.png.empty()) {
       const ReinhardResult tm = tonemapReinhard(image, ReinhardParams{});
@@ -495,6 +513,11 @@ Runner addRenderCommand(CLI::App& app) {
             return parseAovs(v, error) ? std::string() : error;
           },
           "LIST"));
+  cmd->add_flag(
+      "--denoise", args->denoise,
+      "Denoise the image with Intel Open Image Denoise, guided by the albedo and normal AOVs (added "
+      "to --aov); the noisy image stays in the EXR as the layer noisy.R/G/B. Needs the OIDN 2 "
+      "library (scripts/setup-deps.sh installs it; docs/aovs.md)");
   cmd->add_option("--texture-filter", args->textureFilter,
                   "glTF files: how their images are filtered: bilinear (the default; nearest where a sampler "
                   "asks) or trilinear (MIP-mapped over each hit's pixel footprint through OpenImageIO: less "
