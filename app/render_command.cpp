@@ -15,6 +15,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -50,6 +51,7 @@ struct RenderArgs {
   std::optional<double> untilRelerr;
   std::string aovs;
   bool denoise = false;
+  bool adaptive = false;
   bool quiet = false;
   std::string checkpoint, resume, time;
   double checkpointEvery = 60.0;
@@ -187,6 +189,7 @@ RenderSetup setUp(RenderArgs& a) {
                                                    {a.camera >= 0, "--camera"},
                                                    {a.firstSample != 0, "--first-sample"},
                                                    {!a.aovs.empty(), "--aov"},
+                                                   {a.adaptive, "--adaptive"},
                                                    {a.passSpp.has_value(), "--pass-spp"}})
       if (given)
         throw InputError(std::string("--resume takes the render's settings from its checkpoint; ") + name +
@@ -282,10 +285,11 @@ int runRender(RenderArgs a) {
   AovSet aovs = setup.resumed    ? setup.resumed->film.aovs()
                 : a.aovs.empty() ? AovSet{}
                                  : parseAovs(a.aovs, aovError).value();  // CLI11 checked it
-  if (a.denoise && !setup.resumed) {  // the denoiser's guides
+  if (a.denoise && !setup.resumed) {                                     // the denoiser's guides
     aovs.add(Aov::Albedo);
     aovs.add(Aov::Normal);
   }
+  if (a.adaptive && !setup.resumed) aovs.add(Aov::Spp);  // each pixel's own count, which merge weighs by
   scene.uvOnEveryHit = aovs.has(Aov::Uv);
   scene.build();
   if (a.packetWidth != "auto") scene.setPacketWidth(unsigned(std::stoi(a.packetWidth)));
@@ -323,6 +327,19 @@ int runRender(RenderArgs a) {
     if (cluster.distributed()) throw InputError("--until-relerr cannot be used under MPI");
     options.targetRelativeError = *a.untilRelerr;
   }
+  if (a.adaptive) {
+    if (!a.untilRelerr)
+      throw InputError("--adaptive needs --until-relerr X: the relative error each pixel stops at");
+    if (cluster.distributed()) throw InputError("--adaptive cannot be used under MPI");
+    options.adaptive = true;
+  } else if (setup.resumed && setup.resumed->adaptiveTarget > 0.0) {  // the checkpoint's settings
+    if (a.untilRelerr)
+      throw InputError("--until-relerr: the checkpoint samples adaptively to " +
+                       std::to_string(setup.resumed->adaptiveTarget) + " per pixel; resume it without");
+    options.adaptive = true;
+    options.targetRelativeError = setup.resumed->adaptiveTarget;
+    options.adaptivePilotSpp = setup.resumed->adaptivePilotSpp;
+  }
 
   Checkpoint state;
   state.identity = setup.identity;
@@ -331,6 +348,10 @@ int runRender(RenderArgs a) {
   state.passSpp = setup.passSpp;
   state.output = a.output;
   state.emberVersion = EMBER_VERSION;
+  if (options.adaptive) {
+    state.adaptiveTarget = options.targetRelativeError;
+    state.adaptivePilotSpp = options.adaptivePilotSpp;
+  }
   const std::string checkpointPath = rankFile(!a.checkpoint.empty() ? a.checkpoint : a.resume, cluster);
   const bool checkpointing = !a.checkpoint.empty() || (!a.resume.empty() && a.checkpointEvery > 0);
   auto saveState = [&](const Film& f, int passes) {
@@ -377,10 +398,10 @@ int runRender(RenderArgs a) {
                 {"DateTime", isoTime()},
                 {"Software", std::string("ember ") + EMBER_VERSION}};
   if (!film.aovs().empty()) meta.push_back({"ember:aovs", aovList(film.aovs())});
-  if (a.untilRelerr) {
-    meta.push_back({"ember:until_relerr", std::to_string(*a.untilRelerr)});
+  if (a.untilRelerr) meta.push_back({"ember:until_relerr", std::to_string(*a.untilRelerr)});
+  if (options.adaptive) meta.push_back({"ember:adaptive", std::to_string(options.targetRelativeError)});
+  if (options.targetRelativeError > 0.0)
     meta.push_back({"ember:relerr", std::to_string(stats.relativeError)});
-  }
   if (sppDone > 0) {
     Image image = film.mean();
     std::vector<ImageLayer> layers = film.aovLayers();
@@ -415,6 +436,13 @@ int runRender(RenderArgs a) {
                  cluster.size());
   if (stats.outOfTime)
     std::fprintf(stderr, "ember: --time %s: stopped after %d of %d spp\n", a.time.c_str(), sppDone, s.spp);
+  if (options.adaptive && !film.budgets().empty()) {
+    const auto [fewest, most] = std::minmax_element(film.counts().begin(), film.counts().end());
+    double total = 0.0;
+    for (uint32_t n : film.counts()) total += n;
+    std::fprintf(stderr, "ember: --adaptive: pixels took %u to %u samples, %.1f on average\n", *fewest, *most,
+                 total / double(film.pixelCount()));
+  }
   if (a.untilRelerr && !interrupted)
     std::fprintf(stderr, "ember: --until-relerr %g: %s %.4g at %d spp\n", *a.untilRelerr,
                  stats.converged ? "reached" : "not reached, estimated relative error", stats.relativeError,
@@ -513,6 +541,11 @@ Runner addRenderCommand(CLI::App& app) {
             return parseAovs(v, error) ? std::string() : error;
           },
           "LIST"));
+  cmd->add_flag(
+      "--adaptive", args->adaptive,
+      "With --until-relerr X: sample each pixel until its own relative error is about X (a budget "
+      "from its neighbours' first 16 samples, which keeps every pixel unbiased; renderer/adaptive.h); "
+      "the spp layer records each pixel's count");
   cmd->add_flag(
       "--denoise", args->denoise,
       "Denoise the image with Intel Open Image Denoise, guided by the albedo and normal AOVs (added "

@@ -8,6 +8,7 @@
 #include <unistd.h>
 #include <xxhash.h>
 
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -93,6 +94,9 @@ void writeCheckpoint(const std::string& path, const Checkpoint& c) {
                                  {"passes", c.passes},
                                  {"output", c.output},
                                  {"aovs", aovList(c.film.aovs())},
+                                 {"budgets", !c.film.budgets().empty()},
+                                 {"adaptive_target", c.adaptiveTarget},
+                                 {"adaptive_pilot_spp", c.adaptivePilotSpp},
                                  {"ember_version", c.emberVersion}};
   const std::string text = header.dump();
   std::string bytes(kMagic, sizeof kMagic);
@@ -103,6 +107,7 @@ void writeCheckpoint(const std::string& path, const Checkpoint& c) {
   putArray(bytes, c.film.sumsOfSquares());
   putArray(bytes, c.film.counts());
   putArray(bytes, c.film.aovSums());
+  putArray(bytes, c.film.budgets());
   put(bytes, uint64_t(XXH3_64bits(bytes.data(), bytes.size())));
 
   writeAtomically(path, [&](const std::string& tmp) { writeFileDurably(tmp, bytes); });
@@ -136,6 +141,7 @@ Checkpoint readCheckpoint(const std::string& path) {
   if (!header.is_object()) throw InputError(path + ": corrupted checkpoint header (not JSON)");
   Checkpoint c;
   AovSet aovs;
+  bool budgets = false;
   try {
     c.identity = RenderIdentity::fromJson(header.at("identity"), path);
     c.firstSample = header.at("first_sample").get<uint64_t>();
@@ -148,11 +154,17 @@ Checkpoint readCheckpoint(const std::string& path) {
     const std::optional<AovSet> parsed = parseAovs(header.at("aovs").get<std::string>(), error);
     if (!parsed) throw InputError(path + ": corrupted checkpoint header (" + error + ")");
     aovs = *parsed;
+    budgets = header.at("budgets").get<bool>();
+    c.adaptiveTarget = header.at("adaptive_target").get<double>();
+    c.adaptivePilotSpp = header.at("adaptive_pilot_spp").get<int>();
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {
     throw InputError(path + ": corrupted checkpoint header (" + e.what() + ")");
   }
+  if (!std::isfinite(c.adaptiveTarget) || c.adaptiveTarget < 0.0 || c.adaptivePilotSpp < 0 ||
+      (budgets && !(c.adaptiveTarget > 0.0)))
+    throw InputError(path + ": corrupted checkpoint header (adaptive sampling settings)");
   if (c.spp < 1 || c.passSpp < 1 || c.passes < 0 || c.passes > passCount(c.spp, c.passSpp))
     throw InputError(path + ": corrupted checkpoint header (inconsistent sample counts)");
   c.film = Film(c.identity.width, c.identity.height, aovs);
@@ -160,9 +172,13 @@ Checkpoint readCheckpoint(const std::string& path) {
   r.getArray(c.film.sumsOfSquares(), "sums of squares");
   r.getArray(c.film.counts(), "counts");
   r.getArray(c.film.aovSums(), "AOV sums");
+  if (budgets) {
+    c.film.budgets().resize(c.film.pixelCount());
+    r.getArray(c.film.budgets(), "budgets");
+  }
   if (r.offset() + sizeof(uint64_t) != bytes.size())
     throw InputError(path + ": corrupted checkpoint (" + std::to_string(bytes.size() - r.offset() - 8) +
-                     " unexpected bytes after the AOV sums)");
+                     " unexpected bytes after the pixels' state)");
   const uint32_t expected = uint32_t(std::min(c.spp, c.passes * c.passSpp));
   for (uint32_t n : c.film.counts())
     if (n > expected)

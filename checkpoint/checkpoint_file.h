@@ -12,6 +12,7 @@
 //   counts                  width * height u32
 //   AOV sums                width * height * AovLayout(aovs).channels doubles (Film::aovSums), the
 //                           set named in the header's "aovs"
+//   budgets                 width * height u32 (Film::budgets) when the header's "budgets" is true
 //   u64 XXH3-64             of every byte before it
 // A file is written to a temporary name beside the target, flushed to disk, then renamed over it:
 // a reader, or a render killed at any moment, sees the previous checkpoint or the new one, whole.
@@ -35,6 +36,10 @@ struct Checkpoint {
   int passes = 0;   // completed passes the film holds
   std::string output;
   std::string emberVersion;
+  // Adaptive sampling's per-pixel target and pilot (renderer/render.h), 0 when the render is not
+  // adaptive: a resumed render keeps them, so that it sets the same budgets.
+  double adaptiveTarget = 0.0;
+  int adaptivePilotSpp = 0;
   Film film{1, 1};
 };
 

@@ -60,7 +60,7 @@ void traceCausticsInWaves(const Scene& scene, int maxDepth, int rrDepth, uint64_
   const CausticTracer& tracer = scene.causticTracer();
   if (!tracer.enabled() || count <= 0 || !CausticTracer::reachesCaustics(maxDepth)) return;
   // Plain variables, not a structured binding: Clang 14 cannot capture those in the lambda.
-  const CausticTracer::Batch batch = tracer.batchFor(scene.camera());
+  const CausticTracer::Batch batch = tracer.batchFor(scene.camera(), splats.pathFraction());
   const uint64_t paths = batch.paths;
   const float pathsPerPixel = batch.pathsPerPixel;
   std::mutex statsMutex;

@@ -174,22 +174,27 @@ void WaveIntegrator::renderTile(const Scene& scene, const TileWork& work, Film& 
 
   // Camera sample k of the tile is pixel k % pixels (row by row) of sample k / pixels; the wave
   // steps through them in that order, counting instead of dividing.
+  // Under adaptive sampling the samples beyond a pixel's budget are passed over (TileWork::wants).
   int x = work.x0, y = work.y0, sample = 0;
-  for (uint64_t first = 0; first < total; first += Wave::kSize) {
-    const size_t count = size_t(std::min<uint64_t>(Wave::kSize, total - first));
+  for (uint64_t next = 0; next < total;) {
     PhaseClock phases(work.timePhases, stats.phaseNanoseconds);
-    for (size_t i = 0; i < count; ++i) {
-      wave.x[i] = x;
-      wave.y[i] = y;
-      wave.sample[i] = sample;
-      wave.samplers[i] = Sampler(work.sampler, work.seed, uint64_t(y) * width + uint64_t(x),
-                                 work.firstSample + uint64_t(sample));
-      wave.samplerOf[i] = &wave.samplers[i];
+    size_t count = 0;
+    for (; count < Wave::kSize && next < total; ++next) {
+      if (work.wants(x, y, sample)) {
+        const size_t i = count++;
+        wave.x[i] = x;
+        wave.y[i] = y;
+        wave.sample[i] = sample;
+        wave.samplers[i] = Sampler(work.sampler, work.seed, uint64_t(y) * width + uint64_t(x),
+                                   work.firstSample + uint64_t(sample));
+        wave.samplerOf[i] = &wave.samplers[i];
+      }
       if (++x == work.x1) {
         x = work.x0;
         if (++y == work.y1) y = work.y0, ++sample;
       }
     }
+    if (count == 0) break;
     draw2DLanes(wave.samplerOf.data(), count, wave.drawn2D.data());  // the pixel jitter
     // PathIntegrator::start: paths of zero segments carry no light.
     PathArrays& paths = wave.paths;

@@ -35,7 +35,8 @@ float shadingCorrection(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi) {
 
 }  // namespace
 
-void CausticSplats::reset(int indices, int width, int height) {
+void CausticSplats::reset(int indices, int width, int height, double pathFraction) {
+  pathFraction_ = pathFraction;
   const size_t size = size_t(indices) * size_t(width) * size_t(height) * 3;
   if (size > capacity_) {  // a pass's last, shorter batch reuses the cells
     cells_ = std::make_unique<std::atomic<int64_t>[]>(size);
@@ -142,7 +143,7 @@ void CausticTracer::traceAlone(const Scene& scene, int maxDepth, int rrDepth, ui
                                PathStats& stats) const {
   if (!enabled_ || count <= 0 || !reachesCaustics(maxDepth)) return;
   // Plain variables, not a structured binding: Clang 14 cannot capture those in the lambda.
-  const CausticTracer::Batch batch = batchFor(scene.camera());
+  const CausticTracer::Batch batch = batchFor(scene.camera(), splats.pathFraction());
   const uint64_t paths = batch.paths;
   const float pathsPerPixel = batch.pathsPerPixel;
   std::mutex statsMutex;

@@ -56,8 +56,11 @@ struct CausticCaster {
 // result.
 class CausticSplats {
  public:
-  void reset(int indices, int width, int height);
+  // pathFraction: the share of the usual light paths to trace for each index (batchFor), below 1
+  // where adaptive sampling leaves most pixels without samples to splat into.
+  void reset(int indices, int width, int height, double pathFraction = 1.0);
   int indices() const { return indices_; }
+  double pathFraction() const { return pathFraction_; }
   // Thread-safe. False (and nothing added) for a non-finite or out-of-range colour.
   bool add(int index, int x, int y, const Color& c);
   Color at(int index, int x, int y) const;
@@ -65,6 +68,7 @@ class CausticSplats {
  private:
   static constexpr double kScale = 16777216.0;  // 2^24
   int indices_ = 0, width_ = 0, height_ = 0;
+  double pathFraction_ = 1.0;
   size_t size_ = 0, capacity_ = 0;
   std::unique_ptr<std::atomic<int64_t>[]> cells_;
 };
@@ -90,10 +94,12 @@ class CausticTracer {
     uint64_t paths;
     float pathsPerPixel;
   };
-  Batch batchFor(const Camera& camera) const {
+  // `fraction` of them (CausticSplats::pathFraction): each splat is still divided by the paths
+  // per pixel actually traced, so the estimate stays unbiased with fewer.
+  Batch batchFor(const Camera& camera, double fraction = 1.0) const {
     const uint64_t pixels = uint64_t(camera.width()) * uint64_t(camera.height());
     const uint64_t paths =
-        std::max<uint64_t>(1, uint64_t(std::ceil(double(pixels) * double(pathsPerPixel_))));
+        std::max<uint64_t>(1, uint64_t(std::ceil(double(pixels) * double(pathsPerPixel_) * fraction)));
     return {paths, float(double(paths) / double(pixels))};
   }
 

@@ -85,6 +85,10 @@ class Film {
   const std::vector<glm::dvec3>& sums() const { return sum_; }
   const std::vector<glm::dvec3>& sumsOfSquares() const { return sumSq_; }
   const std::vector<uint32_t>& counts() const { return count_; }
+  // Adaptive sampling's per-pixel sample budgets (renderer/adaptive.h), counted from the render's
+  // first sample; empty when the render samples every pixel alike.
+  std::vector<uint32_t>& budgets() { return budget_; }
+  const std::vector<uint32_t>& budgets() const { return budget_; }
   // The AOVs' sums: aovLayout().channels doubles per pixel.
   std::vector<double>& aovSums() { return aovSum_; }
   const std::vector<double>& aovSums() const { return aovSum_; }
@@ -107,6 +111,7 @@ class Film {
   AovSet aovs_;
   AovLayout layout_;
   std::vector<double> aovSum_;
+  std::vector<uint32_t> budget_;
 };
 
 }  // namespace ember

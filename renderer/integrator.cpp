@@ -44,6 +44,7 @@ void Integrator::renderTile(const Scene& scene, const TileWork& work, Film& film
     for (int x = work.x0; x < work.x1; ++x) {
       const uint64_t pixel = uint64_t(y) * width + uint64_t(x);
       for (int s = 0; s < work.spp; ++s) {
+        if (!work.wants(x, y, s)) break;  // a pixel's budget ends its samples
         Sampler sampler(work.sampler, work.seed, pixel, work.firstSample + uint64_t(s));
         const Ray ray = cameraRay(scene, x, y, sampler);
         if (film.aovs().perSample()) {

@@ -47,6 +47,15 @@ struct TileWork {
   // each sample; null when the render traces no caustics.
   const CausticSplats* caustics = nullptr;
   bool timePhases = false;  // charge the batched kernels' time to PathStats::phaseNanoseconds
+  // Adaptive sampling: each pixel's budget (Film::budgets, row by row), counted from the render's
+  // first sample, of which this pass's sample 0 is number `passOffset`; a pixel renders only the
+  // samples within its budget. Null: every sample of the pass.
+  const uint32_t* budgets = nullptr;
+  uint32_t passOffset = 0;
+  int filmWidth = 0;
+  bool wants(int x, int y, int s) const {
+    return !budgets || passOffset + uint32_t(s) < budgets[size_t(y) * size_t(filmWidth) + size_t(x)];
+  }
 };
 
 class Integrator {

@@ -1,5 +1,6 @@
 #include "renderer/render.h"
 
+#include "renderer/adaptive.h"
 #include "renderer/progress.h"
 
 #include <tbb/blocked_range.h>
@@ -58,6 +59,12 @@ RenderStats render(const Scene& scene, const Integrator& integrator, const Rende
                                 std::to_string(scene.camera().width()) + "x" +
                                 std::to_string(scene.camera().height()));
   CausticSplats splats;
+  // Adaptive sampling: the most samples any pixel's budget asks for, once the budgets are set.
+  const auto budgetEnd = [&] {
+    return film.budgets().empty() ? uint32_t(options.spp)
+                                  : std::min(uint32_t(options.spp),
+                                             *std::max_element(film.budgets().begin(), film.budgets().end()));
+  };
   for (int p = firstPass; p < passes; ++p) {
     // The budget admits a pass if the previous one, run again, would end within it; the first
     // pass of a call always runs, so every render adds at least one.
@@ -70,7 +77,17 @@ RenderStats render(const Scene& scene, const Integrator& integrator, const Rende
       stats.interrupted = true;
       break;
     }
-    if (options.targetRelativeError > 0.0 && film.relativeError() <= options.targetRelativeError) {
+    const uint32_t passOffset = uint32_t(p) * uint32_t(passSpp);
+    if (options.adaptive) {
+      // The budgets depend on the pilot passes alone (the film when the pilot ends), so a resumed
+      // render sets the same ones, or has them from its checkpoint.
+      if (film.budgets().empty() && passOffset >= uint32_t(options.adaptivePilotSpp))
+        film.budgets() = adaptiveBudgets(film, options.targetRelativeError, passOffset, kMaxAdaptiveBudget);
+      if (passOffset >= budgetEnd()) {
+        stats.converged = true;
+        break;
+      }
+    } else if (options.targetRelativeError > 0.0 && film.relativeError() <= options.targetRelativeError) {
       stats.converged = true;
       break;
     }
@@ -78,7 +95,16 @@ RenderStats render(const Scene& scene, const Integrator& integrator, const Rende
     std::fill(rendered.begin(), rendered.end(), 0);
     const uint64_t passFirstSample = options.firstSample + uint64_t(p) * uint64_t(passSpp);
     if (traceCaustics) {
-      splats.reset(passSamples(p), width, height);
+      // Under adaptive sampling, light paths in proportion to the samples the pass takes: a light
+      // path's splats land anywhere, and most pixels are done.
+      double fraction = 1.0;
+      if (!film.budgets().empty()) {
+        uint64_t taken = 0;
+        for (uint32_t b : film.budgets())
+          taken += b > passOffset ? std::min<uint64_t>(b - passOffset, uint64_t(passSamples(p))) : 0;
+        fraction = double(taken) / double(pixels * uint64_t(passSamples(p)));
+      }
+      splats.reset(passSamples(p), width, height, fraction);
       PathStats traced;
       arena.execute([&] {
         integrator.traceCaustics(scene, options.seed, options.sampler, passFirstSample, passSamples(p),
@@ -107,6 +133,11 @@ RenderStats render(const Scene& scene, const Integrator& integrator, const Rende
               work.sampler = options.sampler;
               work.caustics = traceCaustics ? &splats : nullptr;
               work.timePhases = options.timePhases;
+              if (!film.budgets().empty()) {
+                work.budgets = film.budgets().data();
+                work.passOffset = passOffset;
+                work.filmWidth = width;
+              }
               if (options.stop) film.save(work.x0, work.y0, work.x1, work.y1, backups[size_t(t)]);
               integrator.renderTile(scene, work, film, local);
               rendered[size_t(t)] = 1;
@@ -129,17 +160,25 @@ RenderStats render(const Scene& scene, const Integrator& integrator, const Rende
       break;
     }
     lastPass = std::chrono::duration<double>(Clock::now() - passStart).count();
-    stats.samples += pixels * uint64_t(passSamples(p));
+    if (film.budgets().empty()) {
+      stats.samples += pixels * uint64_t(passSamples(p));
+    } else {
+      for (uint32_t b : film.budgets())
+        stats.samples += b > passOffset ? std::min<uint64_t>(b - passOffset, uint64_t(passSamples(p))) : 0;
+    }
     stats.passes = p + 1;
     if (options.onPass) options.onPass(film, stats.passes);
   }
   progress.finish();
   if (options.targetRelativeError > 0.0) {
     stats.relativeError = film.relativeError();
-    stats.converged = stats.relativeError <= options.targetRelativeError;
+    stats.converged = options.adaptive
+                          ? !film.budgets().empty() && uint32_t(stats.passes * passSpp) >= budgetEnd()
+                          : stats.relativeError <= options.targetRelativeError;
   }
   stats.seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  stats.sppDone = std::min(options.spp, stats.passes * passSpp);
+  stats.sppDone =
+      int(std::min<uint32_t>(budgetEnd(), uint32_t(std::min(options.spp, stats.passes * passSpp))));
   stats.nonFinite = stats.paths.nonFinite;
   return stats;
 }

@@ -37,6 +37,12 @@ struct RenderOptions {
   // on the film alone, before every pass (the first of a resumed render's too), so a render
   // stopped and resumed ends at the same pass as one run through.
   double targetRelativeError = 0.0;
+  // Adaptive sampling (renderer/adaptive.h): targetRelativeError then applies to each pixel. Every
+  // pixel first takes the first whole passes holding at least `adaptivePilotSpp` samples; the film
+  // then gets each pixel's budget (Film::budgets, kept by checkpoints), and later passes sample a
+  // pixel only within it. The render ends when every budget is spent, or at `spp`.
+  bool adaptive = false;
+  int adaptivePilotSpp = 16;
   // Called after each completed pass with the number of passes the film now holds.
   std::function<void(const Film&, int passes)> onPass;
 };
@@ -51,7 +57,7 @@ struct RenderStats {
   int threads = 0;
   uint64_t samples = 0;        // samples per pixel added by this call, times the pixel count
   int passes = 0;              // passes the film holds at the end (earlier ones included)
-  int sppDone = 0;             // samples per pixel the film holds at the end
+  int sppDone = 0;             // samples per pixel the film holds at the end (the most, if adaptive)
   bool interrupted = false;    // options.stop was set
   bool outOfTime = false;      // the time budget ended the render before options.spp
   bool converged = false;      // the film reached options.targetRelativeError
