@@ -8,6 +8,7 @@
 #include "io/image_io.h"
 #include "io/input_error.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -43,31 +44,47 @@ int runDenoise(const DenoiseArgs& a) {
       image.rgb[3 * i + size_t(c)] = values[i];
     }
   }
-  // Every other channel is kept as it is; the guides are those of the render.
+  // Every other channel is kept as it is; the guides are those of the render. A guide must be whole
+  // and finite: the filter would spread a NaN over its neighbourhood.
   std::vector<ImageLayer> layers;
+  std::vector<std::string> gathered;
   const auto gather = [&](std::vector<std::string> names) {
-    for (const std::string& n : names)
-      if (!exr.has(n)) return;
+    size_t present = 0;
+    for (const std::string& n : names) present += exr.has(n) ? 1 : 0;
+    if (present == 0) return;
+    if (present != names.size())
+      throw InputError(a.input + ": the layer " + names[0].substr(0, names[0].find('.')) + " lacks some of " +
+                       names[0] + ", " + names[1] + ", " + names[2]);
     ImageLayer layer{names, std::vector<float>(pixels * names.size())};
     for (size_t k = 0; k < names.size(); ++k)
-      for (size_t i = 0; i < pixels; ++i) layer.pixels[i * names.size() + k] = exr.channels.at(names[k])[i];
+      for (size_t i = 0; i < pixels; ++i) {
+        const float v = exr.channels.at(names[k])[i];
+        if (!std::isfinite(v))
+          throw InputError(a.input + ": channel " + names[k] + " holds a NaN or infinite value at pixel (" +
+                           std::to_string(i % size_t(exr.width)) + ", " +
+                           std::to_string(i / size_t(exr.width)) + ")");
+        layer.pixels[i * names.size() + k] = v;
+      }
+    gathered.insert(gathered.end(), names.begin(), names.end());
     layers.push_back(std::move(layer));
   };
-  gather({"noisy.R", "noisy.G", "noisy.B"});
+  if (denoisedBefore) gather({"noisy.R", "noisy.G", "noisy.B"});
   if (!denoisedBefore) layers.push_back({{"noisy.R", "noisy.G", "noisy.B"}, image.rgb});
   gather({"albedo.R", "albedo.G", "albedo.B"});
   gather({"N.X", "N.Y", "N.Z"});
   for (const auto& [name, values] : exr.channels) {
-    const bool taken = name == "R" || name == "G" || name == "B" || name.rfind("noisy.", 0) == 0 ||
-                       name.rfind("albedo.", 0) == 0 || name.rfind("N.", 0) == 0;
+    const bool taken = name == "R" || name == "G" || name == "B" ||
+                       std::find(gathered.begin(), gathered.end(), name) != gathered.end() ||
+                       (!denoisedBefore && name.rfind("noisy.", 0) == 0);
     if (!taken) layers.push_back({{name}, values});
   }
   const auto start = std::chrono::steady_clock::now();
   image.rgb = denoise(denoiseInput(image, layers), DenoiseOptions{a.threads, !a.noPrefilter});
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   Metadata meta;
+  // OpenEXR's own string attributes (a multi-part file's part name and type) describe the input file.
   for (const auto& [k, v] : exr.metadata)
-    if (k != "ember:denoiser") meta.emplace_back(k, v);
+    if (k != "ember:denoiser" && k != "name" && k != "type" && k != "view") meta.emplace_back(k, v);
   meta.emplace_back("ember:denoiser",
                     denoiserDescription(layers) + (a.noPrefilter ? ", guides as given" : ""));
   writeExr(a.output, image, layers, meta);

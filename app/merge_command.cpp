@@ -38,6 +38,9 @@ struct Input {
   std::string path;
   std::map<std::string, std::string> meta;
   ExrChannels exr;
+  // Its spp and coverage layers, where it has them (set once the inputs are read).
+  mutable const float* sppLayer = nullptr;
+  mutable const float* coverage = nullptr;
   uint64_t first = 0;
   uint64_t spp = 0;
 };
@@ -75,6 +78,11 @@ int runMerge(const MergeArgs& a) {
     if (in.spp == 0) throw InputError(path + ": holds no samples");
     for (const char* c : {"R", "G", "B"})
       if (!in.exr.has(c)) throw InputError(path + ": no " + c + " channel: not an image rendered by Ember");
+    // A denoised colour is no longer a mean of samples: averaging two is not their union's image.
+    if (in.meta.count("ember:denoiser") || in.exr.has("noisy.R"))
+      throw InputError(path +
+                       ": a denoised image; merge the renders without --denoise, then denoise the merged "
+                       "one (ember denoise)");
     inputs.push_back(std::move(in));
   }
   const Input& base = inputs.front();
@@ -111,13 +119,17 @@ int runMerge(const MergeArgs& a) {
   const int width = base.exr.width, height = base.exr.height;
   const size_t pixels = size_t(width) * size_t(height);
   // Input k's samples at pixel i: its spp layer's, else its spp everywhere.
-  const auto samples = [&](const Input& in, size_t i) {
+  for (const Input& in : inputs) {
     const auto it = in.exr.channels.find("spp");
-    return it != in.exr.channels.end() ? double(it->second[i]) : double(in.spp);
+    in.sppLayer = it != in.exr.channels.end() ? it->second.data() : nullptr;
+    const auto c = in.exr.channels.find("coverage");
+    in.coverage = c != in.exr.channels.end() ? c->second.data() : nullptr;
+  }
+  const auto samples = [&](const Input& in, size_t i) {
+    return in.sppLayer ? double(in.sppLayer[i]) : double(in.spp);
   };
   const auto hits = [&](const Input& in, size_t i) {
-    const auto it = in.exr.channels.find("coverage");
-    return samples(in, i) * (it != in.exr.channels.end() ? double(it->second[i]) : 1.0);
+    return samples(in, i) * (in.coverage ? double(in.coverage[i]) : 1.0);
   };
   // Every channel: a mean over the samples (weights `samples`) or over the hits (`hits`).
   std::map<std::string, std::vector<float>> merged;
@@ -126,11 +138,13 @@ int runMerge(const MergeArgs& a) {
     const bool overHits = name == "Z" || name.rfind("P.", 0) == 0 || name.rfind("uv.", 0) == 0;
     std::vector<float>& out = merged[name];
     out.resize(pixels);
+    std::vector<const float*> values;
+    for (const Input& in : inputs) values.push_back(in.exr.channels.at(name).data());
     for (size_t i = 0; i < pixels; ++i) {
       double sum = 0.0, weight = 0.0;
-      for (const Input& in : inputs) {
-        const double w = overHits ? hits(in, i) : samples(in, i);
-        if (w > 0.0) sum += double(in.exr.channels.at(name)[i]) * w;
+      for (size_t k = 0; k < inputs.size(); ++k) {
+        const double w = overHits ? hits(inputs[k], i) : samples(inputs[k], i);
+        if (w > 0.0) sum += double(values[k][i]) * w;
         weight += w;
       }
       out[i] = weight > 0.0  ? float(sum / weight)
@@ -147,21 +161,31 @@ int runMerge(const MergeArgs& a) {
       out[i] = float(n);
     }
   }
-  // The variance of the union's mean from each input's mean m and variance of the mean v over n
-  // samples, which give back its sum of squares Q = (n - 1) n v + n m^2; the union's variance of
-  // the mean is (sum Q - N M^2) / ((N - 1) N) with N = sum n and M the merged mean.
+  // The variance of the union's mean from each input's mean m_k and variance of the mean v_k over
+  // n_k samples (Chan et al. 1979's pairwise update, which takes no difference of large sums):
+  // (sum (n_k - 1) n_k v_k + sum n_k (m_k - M)^2) / ((N - 1) N), N = sum n_k, M the union's mean.
   const auto mergeVariance = [&](const std::vector<const std::vector<float>*>& vars,
                                  const std::string& colour, std::vector<float>& out) {
     out.resize(pixels);
+    std::vector<const float*> means;
+    for (const Input& in : inputs) means.push_back(in.exr.channels.at(colour).data());
     for (size_t i = 0; i < pixels; ++i) {
-      double q = 0.0, n = 0.0;
+      double n = 0.0, sum = 0.0;
       for (size_t k = 0; k < inputs.size(); ++k) {
-        const double nk = samples(inputs[k], i), m = inputs[k].exr.channels.at(colour)[i];
-        q += (nk - 1.0) * nk * double((*vars[k])[i]) + nk * m * m;
-        n += nk;
+        n += samples(inputs[k], i);
+        sum += samples(inputs[k], i) * double(means[k][i]);
       }
-      const double mean = merged.at(colour)[i];
-      out[i] = n > 1.0 ? float(std::max(0.0, (q - n * mean * mean) / ((n - 1.0) * n))) : 0.0f;
+      if (!(n > 1.0)) {
+        out[i] = 0.0f;
+        continue;
+      }
+      const double mean = sum / n;
+      double q = 0.0;
+      for (size_t k = 0; k < inputs.size(); ++k) {
+        const double nk = samples(inputs[k], i), d = double(means[k][i]) - mean;
+        q += (nk - 1.0) * nk * double((*vars[k])[i]) + nk * d * d;
+      }
+      out[i] = float(q / ((n - 1.0) * n));
     }
   };
   for (const char* c : {"R", "G", "B"})

@@ -329,13 +329,14 @@ int runRender(RenderArgs a) {
   }
   if (a.adaptive) {
     if (!a.untilRelerr)
-      throw InputError("--adaptive needs --until-relerr X: the relative error each pixel stops at");
+      throw InputError("--adaptive needs --until-relerr X: the relative error the image is to reach");
     if (cluster.distributed()) throw InputError("--adaptive cannot be used under MPI");
     options.adaptive = true;
   } else if (setup.resumed && setup.resumed->adaptiveTarget > 0.0) {  // the checkpoint's settings
+    if (cluster.distributed()) throw InputError("--adaptive cannot be used under MPI");
     if (a.untilRelerr)
       throw InputError("--until-relerr: the checkpoint samples adaptively to " +
-                       std::to_string(setup.resumed->adaptiveTarget) + " per pixel; resume it without");
+                       std::to_string(setup.resumed->adaptiveTarget) + "; resume it without");
     options.adaptive = true;
     options.targetRelativeError = setup.resumed->adaptiveTarget;
     options.adaptivePilotSpp = setup.resumed->adaptivePilotSpp;
@@ -407,11 +408,24 @@ int runRender(RenderArgs a) {
     std::vector<ImageLayer> layers = film.aovLayers();
     if (a.denoise) {
       const auto denoiseStart = Clock::now();
-      layers.insert(layers.begin(), ImageLayer{{"noisy.R", "noisy.G", "noisy.B"}, image.rgb});
-      image.rgb = denoise(denoiseInput(image, layers), DenoiseOptions{a.threads.value_or(0), true});
+      std::vector<ImageLayer> withNoisy = layers;
+      withNoisy.insert(withNoisy.begin(), ImageLayer{{"noisy.R", "noisy.G", "noisy.B"}, image.rgb});
+      try {
+        image.rgb = denoise(denoiseInput(image, withNoisy), DenoiseOptions{a.threads.value_or(0), true});
+      } catch (const DenoiseError& e) {
+        // The render is not thrown away: its noisy image is written, and `ember denoise` can retry.
+        writeExr(a.output, image, layers, meta);
+        throw InputError(std::string(e.what()) + " (the render's noisy image was written to " + a.output +
+                         "; denoise it with ember denoise)");
+      }
+      layers = std::move(withNoisy);
       const double seconds = std::chrono::duration<double>(Clock::now() - denoiseStart).count();
       meta.push_back({"ember:denoiser", denoiserDescription(layers)});
       std::fprintf(stderr, "ember: denoised in %.3f s (%s)\n", seconds, oidnLibraryPath().c_str());
+      if (!film.aovs().has(Aov::Albedo))
+        std::fprintf(stderr,
+                     "ember: warning: the checkpoint has no albedo or normal layers: denoised from the "
+                     "colour alone\n");
     }
     writeExr(a.output, image, layers, meta);
     if (!a.variance.empty()) writeExr(a.variance, film.varianceOfMean(), meta);

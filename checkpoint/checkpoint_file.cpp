@@ -2,6 +2,7 @@
 
 #include "io/input_error.h"
 #include "io/pending_file.h"
+#include "renderer/adaptive.h"
 #include "renderer/render.h"
 
 #include <fcntl.h>
@@ -163,7 +164,7 @@ Checkpoint readCheckpoint(const std::string& path) {
     throw InputError(path + ": corrupted checkpoint header (" + e.what() + ")");
   }
   if (!std::isfinite(c.adaptiveTarget) || c.adaptiveTarget < 0.0 || c.adaptivePilotSpp < 0 ||
-      (budgets && !(c.adaptiveTarget > 0.0)))
+      (c.adaptiveTarget > 0.0 && c.adaptivePilotSpp < 1) || (budgets && !(c.adaptiveTarget > 0.0)))
     throw InputError(path + ": corrupted checkpoint header (adaptive sampling settings)");
   if (c.spp < 1 || c.passSpp < 1 || c.passes < 0 || c.passes > passCount(c.spp, c.passSpp))
     throw InputError(path + ": corrupted checkpoint header (inconsistent sample counts)");
@@ -183,6 +184,12 @@ Checkpoint readCheckpoint(const std::string& path) {
   for (uint32_t n : c.film.counts())
     if (n > expected)
       throw InputError(path + ": corrupted checkpoint (a pixel holds more samples than its passes)");
+  for (size_t i = 0; i < c.film.budgets().size(); ++i) {
+    const uint32_t b = c.film.budgets()[i];
+    if (b < uint32_t(c.adaptivePilotSpp) || b > kMaxAdaptiveBudget || c.film.counts()[i] > b)
+      throw InputError(path + ": corrupted checkpoint (pixel " + std::to_string(i) + "'s sample budget " +
+                       std::to_string(b) + " is impossible)");
+  }
   return c;
 }
 

@@ -8,6 +8,11 @@ namespace ember {
 
 namespace {
 
+// The guides' prefilters at OIDN's balanced quality: at 1920x1080 on 2 threads each takes 3.2 s
+// instead of 7.5 s at high quality, and the colour filtered after them was as close to the
+// references (relMSE 0.00169 against 0.00169 on cornell-area at 16 spp, 0.00033 both on shapes).
+constexpr int kGuideQuality = OidnApi::kQualityBalanced;
+
 // One OIDN device per call: its threads come and go with it.
 class Device {
  public:
@@ -15,7 +20,12 @@ class Device {
     if (!device_) throw DenoiseError("OIDN: cannot create a CPU device");
     if (threads > 0) api_.setDeviceInt(device_, "numThreads", threads);
     api_.commitDevice(device_);
-    check("creating the device");
+    try {
+      check("creating the device");
+    } catch (...) {  // the destructor does not run for a constructor that throws
+      api_.releaseDevice(device_);
+      throw;
+    }
   }
   ~Device() { api_.releaseDevice(device_); }
   Device(const Device&) = delete;
@@ -29,7 +39,7 @@ class Device {
 
   // Runs one RT filter over images given as (name, pixels) pairs; `output` receives the result.
   void run(const std::vector<std::pair<const char*, const float*>>& images, float* output, int width,
-           int height, bool hdr, bool cleanAux) {
+           int height, bool hdr, bool cleanAux, int quality) {
     OidnApi::Filter f = api_.newFilter(device_, "RT");
     if (!f) {
       check("creating the RT filter");
@@ -48,7 +58,7 @@ class Device {
     set("output", output);
     if (hdr) api_.setFilterBool(f, "hdr", true);
     if (cleanAux) api_.setFilterBool(f, "cleanAux", true);
-    api_.setFilterInt(f, "quality", OidnApi::kQualityHigh);
+    api_.setFilterInt(f, "quality", quality);
     api_.commitFilter(f);
     check("setting up the filter");
     api_.executeFilter(f);
@@ -108,17 +118,20 @@ std::vector<float> denoise(const DenoiseInput& in, const DenoiseOptions& options
   std::vector<float> cleanAlbedo, cleanNormal;
   if (albedo && options.prefilterGuides) {
     cleanAlbedo.resize(n);
-    device.run({{"albedo", in.albedo.data()}}, cleanAlbedo.data(), in.width, in.height, false, false);
+    device.run({{"albedo", in.albedo.data()}}, cleanAlbedo.data(), in.width, in.height, false, false,
+               kGuideQuality);
   }
   if (normal && options.prefilterGuides) {
     cleanNormal.resize(n);
-    device.run({{"normal", in.normal.data()}}, cleanNormal.data(), in.width, in.height, false, false);
+    device.run({{"normal", in.normal.data()}}, cleanNormal.data(), in.width, in.height, false, false,
+               kGuideQuality);
   }
   std::vector<std::pair<const char*, const float*>> images{{"color", in.color.data()}};
   if (albedo) images.push_back({"albedo", options.prefilterGuides ? cleanAlbedo.data() : in.albedo.data()});
   if (normal) images.push_back({"normal", options.prefilterGuides ? cleanNormal.data() : in.normal.data()});
   std::vector<float> out(n);
-  device.run(images, out.data(), in.width, in.height, true, albedo && options.prefilterGuides);
+  device.run(images, out.data(), in.width, in.height, true, albedo && options.prefilterGuides,
+             OidnApi::kQualityHigh);
   return out;
 }
 

@@ -2,7 +2,7 @@
 // guided by the albedo and normal AOVs (renderer/aov.h). The guides are noisy too (a few samples
 // per pixel), so each is first denoised alone and the colour filter is then told they are clean
 // (cleanAux): OIDN's recommended "prefiltering" for the highest quality, which keeps the guides'
-// noise out of the result.
+// noise out of the result. The colour filter runs at OIDN's high quality, the guides' at balanced.
 #pragma once
 
 #include "renderer/film.h"

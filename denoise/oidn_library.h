@@ -19,9 +19,10 @@ namespace ember {
 struct OidnApi {
   using Device = void*;
   using Filter = void*;
-  static constexpr int kDeviceCpu = 1;     // OIDN_DEVICE_TYPE_CPU
-  static constexpr int kFormatFloat3 = 3;  // OIDN_FORMAT_FLOAT3
-  static constexpr int kQualityHigh = 6;   // OIDN_QUALITY_HIGH
+  static constexpr int kDeviceCpu = 1;        // OIDN_DEVICE_TYPE_CPU
+  static constexpr int kFormatFloat3 = 3;     // OIDN_FORMAT_FLOAT3
+  static constexpr int kQualityBalanced = 5;  // OIDN_QUALITY_BALANCED
+  static constexpr int kQualityHigh = 6;      // OIDN_QUALITY_HIGH
   Device (*newDevice)(int type) = nullptr;
   void (*setDeviceInt)(Device, const char* name, int value) = nullptr;
   void (*commitDevice)(Device) = nullptr;

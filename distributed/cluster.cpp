@@ -18,6 +18,23 @@ bool launchedByMpi() {
   return false;
 }
 
+#ifdef EMBER_HAVE_MPI
+// The AOV sums can pass MPI's int count (13 doubles per pixel): sent in pieces of at most 2^30.
+constexpr size_t kChunk = size_t(1) << 30;
+
+void sendInChunks(const std::vector<double>& values, int tag) {
+  for (size_t at = 0; at < values.size(); at += kChunk)
+    MPI_Send(values.data() + at, int(std::min(kChunk, values.size() - at)), MPI_DOUBLE, 0, tag,
+             MPI_COMM_WORLD);
+}
+
+void receiveInChunks(std::vector<double>& values, int from, int tag) {
+  for (size_t at = 0; at < values.size(); at += kChunk)
+    MPI_Recv(values.data() + at, int(std::min(kChunk, values.size() - at)), MPI_DOUBLE, from, tag,
+             MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+}
+#endif
+
 }  // namespace
 
 bool clusterSupport() {
@@ -67,8 +84,7 @@ void Cluster::reduceToRoot(Film& film) const {
     MPI_Send(film.sums().data(), 3 * n, MPI_DOUBLE, 0, 0, MPI_COMM_WORLD);
     MPI_Send(film.sumsOfSquares().data(), 3 * n, MPI_DOUBLE, 0, 1, MPI_COMM_WORLD);
     MPI_Send(film.counts().data(), n, MPI_UINT32_T, 0, 2, MPI_COMM_WORLD);
-    if (!film.aovSums().empty())
-      MPI_Send(film.aovSums().data(), int(film.aovSums().size()), MPI_DOUBLE, 0, 3, MPI_COMM_WORLD);
+    sendInChunks(film.aovSums(), 3);
     return;
   }
   const size_t pixels = static_cast<size_t>(n);
@@ -79,8 +95,7 @@ void Cluster::reduceToRoot(Film& film) const {
     MPI_Recv(sums.data(), 3 * n, MPI_DOUBLE, r, 0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
     MPI_Recv(squares.data(), 3 * n, MPI_DOUBLE, r, 1, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
     MPI_Recv(counts.data(), n, MPI_UINT32_T, r, 2, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-    if (!aovs.empty())
-      MPI_Recv(aovs.data(), int(aovs.size()), MPI_DOUBLE, r, 3, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    receiveInChunks(aovs, r, 3);
     for (size_t i = 0; i < aovs.size(); ++i) film.aovSums()[i] += aovs[i];
     for (size_t i = 0; i < pixels; ++i) {
       film.sums()[i] += sums[i];

@@ -56,8 +56,7 @@ bool Lambertian::finishSample(const SurfaceHit& hit, const Vec3& wo, const Vec3&
                               BsdfSample& out) const {
   out.wi = wi;
   out.pdf = pdf;
-  // With a shading normal the sampled direction can dip below the geometric surface: absorb it.
-  if (out.pdf <= 0.0f || !sameSide(hit, wo, out.wi)) return false;
+  if (!keepsSample(hit.ng, wo, wi, pdf)) return false;
   out.weight = reflectanceAt(hit);
   out.delta = false;
   out.eta = 1.0f;

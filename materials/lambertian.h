@@ -49,6 +49,15 @@ class Lambertian final : public Material {
   // The sample from the kernel's direction and pdf.
   bool finishSample(const SurfaceHit& hit, const Vec3& wo, const Vec3& wi, float pdf, BsdfSample& out) const;
 
+ public:
+  // Whether a cosine-sampled direction wi (density pdf) is kept: with a shading normal it can dip
+  // below the geometric surface, and is then absorbed. The batched driver's inline Lambertian
+  // vertices take the same test (packet/wave_integrator.cpp).
+  static bool keepsSample(const Vec3& ng, const Vec3& wo, const Vec3& wi, float pdf) {
+    return !(pdf <= 0.0f) && glm::dot(wo, ng) * glm::dot(wi, ng) > 0.0f;
+  }
+
+ private:
   std::shared_ptr<const Texture> reflectance_;
   bool constant_;        // the texture is the same everywhere (Texture::isConstant)
   Color constantValue_;  // then its value, which is its maxValue

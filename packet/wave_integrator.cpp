@@ -1,5 +1,7 @@
 #include "packet/wave_integrator.h"
 
+#include "materials/lambertian.h"
+
 #include "core/sampling.h"
 #include "core/warp_lanes.h"
 #include "packet/arrival_lanes.h"
@@ -460,9 +462,8 @@ void WaveIntegrator::renderTile(const Scene& scene, const TileWork& work, Film& 
           if (wave.general[v]) {
             PathIntegrator::aovOnSample(cont.generalSampled[v] != 0, load3(cont.weight, v), aov);
           } else {  // Lambertian::sample's test, and its weight: the reflectance
-            const Vec3 ng = load3(nee.ng, v), wi = load3(cont.wi, v);
             const bool sampled =
-                !(cont.pdf[v] <= 0.0f) && glm::dot(load3(nee.wo, v), ng) * glm::dot(wi, ng) > 0.0f;
+                Lambertian::keepsSample(load3(nee.ng, v), load3(nee.wo, v), load3(cont.wi, v), cont.pdf[v]);
             PathIntegrator::aovOnSample(sampled, load3(nee.albedo, v), aov);
           }
         }

@@ -11,8 +11,7 @@ std::vector<double> relativeSampleVariance(const Film& film) {
     const double n = film.counts()[i];
     if (n < 2) continue;
     const glm::dvec3 m = film.sums()[i] / n;
-    const glm::dvec3 s2 = glm::max(glm::dvec3(0.0), (film.sumsOfSquares()[i] - n * m * m) / (n - 1.0));
-    const glm::dvec3 rel = s2 / (m * m + 0.01);
+    const glm::dvec3 rel = film.sampleVariance(i) / (m * m + 0.01);
     v[i] = (rel.x + rel.y + rel.z) / 3.0;
   }
   return v;
@@ -22,8 +21,12 @@ std::vector<uint32_t> adaptiveBudgets(const Film& film, double target, uint32_t 
   const int w = film.width(), h = film.height();
   const std::vector<double> v = relativeSampleVariance(film);
   std::vector<double> sigma(v.size());
-  double total = 0.0;
-  for (size_t i = 0; i < v.size(); ++i) total += sigma[i] = std::sqrt(v[i]);
+  for (size_t i = 0; i < v.size(); ++i) sigma[i] = std::sqrt(v[i]);
+  // Sums of sigma before and after each pixel, so that the image mean for pixel i is formed
+  // without it (a total minus sigma_i would carry sigma_i's rounding into i's budget).
+  std::vector<double> before(v.size() + 1, 0.0), after(v.size() + 1, 0.0);
+  for (size_t i = 0; i < v.size(); ++i) before[i + 1] = before[i] + sigma[i];
+  for (size_t i = v.size(); i-- > 0;) after[i] = after[i + 1] + sigma[i];
   std::vector<uint32_t> budget(v.size(), std::max(pilot, cap));
   if (v.size() < 2) return budget;
   const double inverseTarget2 = 1.0 / (target * target);
@@ -40,8 +43,10 @@ std::vector<uint32_t> adaptiveBudgets(const Film& film, double target, uint32_t 
           ++neighbours;
         }
       local /= neighbours;
-      const double mean = (total - sigma[i]) / double(v.size() - 1);  // over the other pixels
-      const double needed = std::ceil(local * mean * inverseTarget2);
+      const double mean = (before[i] + after[i + 1]) / double(v.size() - 1);  // over the other pixels
+      const double product = local * mean;
+      // A noiseless neighbourhood needs nothing past the pilot (also where 1 / target^2 overflows).
+      const double needed = product > 0.0 ? std::ceil(product * inverseTarget2) : 0.0;
       budget[i] = uint32_t(std::clamp(needed, double(pilot), double(std::max(pilot, cap))));
     }
   return budget;

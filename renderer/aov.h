@@ -17,10 +17,6 @@
 
 namespace ember {
 
-struct BsdfSample;
-struct SurfaceHit;
-class Scene;
-
 enum class Aov : uint32_t {
   Albedo = 1u << 0,
   Normal = 1u << 1,
@@ -60,7 +56,7 @@ std::string aovList(AovSet set);
 
 // One camera sample's AOVs as the path tracer records them (PathIntegrator's aov steps).
 struct AovSample {
-  Color albedo{0.0f};  // the Dirac chain's weight (clamped to [0, 1]) until the albedo is known
+  Color albedo{0.0f};  // from surfaceFound until albedoKnown: the Dirac chain's weight, clamped to [0, 1]
   Vec3 normal{0.0f};
   Vec3 position{0.0f};
   Vec2 uv{0.0f};

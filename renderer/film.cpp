@@ -93,9 +93,7 @@ Image Film::varianceOfMean() const {
       const size_t i = size_t(y) * size_t(width_) + size_t(x);
       const double n = count_[i];
       if (n < 2) continue;
-      const glm::dvec3 m = sum_[i] / n;
-      const glm::dvec3 var = glm::max(glm::dvec3(0.0), (sumSq_[i] - n * m * m) / (n - 1.0));
-      img.set(x, y, Color(var / n));
+      img.set(x, y, Color(sampleVariance(i) / n));
     }
   return img;
 }
@@ -106,7 +104,7 @@ double Film::relativeError() const {
     const double n = count_[i];
     if (n < 2) return std::numeric_limits<double>::infinity();
     const glm::dvec3 m = sum_[i] / n;
-    const glm::dvec3 varOfMean = glm::max(glm::dvec3(0.0), (sumSq_[i] - n * m * m) / (n - 1.0)) / n;
+    const glm::dvec3 varOfMean = sampleVariance(i) / n;
     const glm::dvec3 rel = varOfMean / (m * m + 0.01);
     sum += rel.x + rel.y + rel.z;
   }

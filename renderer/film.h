@@ -63,6 +63,13 @@ class Film {
   Image mean() const;
   // Variance of each pixel's mean: sample variance / n (unbiased, n - 1 in the denominator).
   Image varianceOfMean() const;
+  // Pixel i's sample variance per channel (n - 1 in the denominator); 0 below 2 samples.
+  glm::dvec3 sampleVariance(size_t i) const {
+    const double n = count_[i];
+    if (n < 2) return glm::dvec3(0.0);
+    const glm::dvec3 m = sum_[i] / n;
+    return glm::max(glm::dvec3(0.0), (sumSq_[i] - n * m * m) / (n - 1.0));
+  }
   // The image's estimated relative error: sqrt of the mean over pixels and channels of
   // Var(mean) / (mean^2 + 0.01), i.e. the root of the relMSE (Rousselle et al. 2011's regularised
   // form, as `ember compare` reports it) the image is expected to have against its converged

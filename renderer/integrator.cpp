@@ -18,18 +18,30 @@ void addToFilm(Film& film, int x, int y, const Color& L, PathStats& stats) {
   }
 }
 
+namespace {
+
+// The one place a finished sample (with the light tracer's splat for it) reaches the film.
+void addSampleToFilm(Film& film, const TileWork& work, int x, int y, int s, const Color& L,
+                     const AovSample* aov, PathStats& stats) {
+  const Color total = work.caustics ? L + work.caustics->at(s, x, y) : L;
+  if (!isFinite(total)) {
+    ++stats.nonFinite;
+  } else if (aov) {
+    film.addSample(x, y, total, *aov);
+  } else {
+    film.addSample(x, y, total);
+  }
+}
+
+}  // namespace
+
 void addToFilm(Film& film, const TileWork& work, int x, int y, int s, const Color& L, PathStats& stats) {
-  addToFilm(film, x, y, work.caustics ? L + work.caustics->at(s, x, y) : L, stats);
+  addSampleToFilm(film, work, x, y, s, L, nullptr, stats);
 }
 
 void addToFilm(Film& film, const TileWork& work, int x, int y, int s, const Color& L, const AovSample& aov,
                PathStats& stats) {
-  const Color total = work.caustics ? L + work.caustics->at(s, x, y) : L;
-  if (isFinite(total)) {
-    film.addSample(x, y, total, aov);
-  } else {
-    ++stats.nonFinite;
-  }
+  addSampleToFilm(film, work, x, y, s, L, &aov, stats);
 }
 
 void Integrator::traceCaustics(const Scene& scene, uint64_t seed, SamplerType sampler, uint64_t firstIndex,

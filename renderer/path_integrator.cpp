@@ -196,10 +196,19 @@ void PathIntegrator::aovOnArrival(const PathState& path, const SurfaceHit& hit, 
   aov.normal = hit.material ? facingNormal(hit, wo) : (glm::dot(wo, hit.ng) >= 0.0f ? hit.ng : -hit.ng);
   aov.albedo = clamp01(path.throughput);
   if (scatters) return;  // the BSDF sample gives the rest (aovOnSample)
-  // A surface without a material is an emitter alone: its colour stands for its albedo. A vertex
-  // that absorbs everything, or ends the path at the depth limit, has none.
-  aov.albedo = hit.material ? Color(0.0f) : aov.albedo * clamp01(hit.emitted(wo));
   aov.albedoKnown = true;
+  // A surface without a material is an emitter alone: its colour stands for its albedo.
+  if (!hit.material) {
+    aov.albedo *= clamp01(hit.emitted(wo));
+    return;
+  }
+  // A vertex where the path ends at the depth limit (it would scatter otherwise) still has an
+  // albedo: one BSDF sample at fixed numbers gives it (the reflectance exactly for a Lambertian
+  // surface), so that --max-depth 1 leaves the denoiser its guide. One that absorbs has none.
+  BsdfSample bs;
+  const bool sampled = !hit.material->absorbsAt(hit) && hit.material->hasNonDeltaLobes() &&
+                       hit.material->sample(hit, wo, Vec2(0.5f), 0.5f, bs);
+  aov.albedo = sampled ? aov.albedo * clamp01(bs.weight) : Color(0.0f);
 }
 
 void PathIntegrator::aovOnSample(bool sampled, const Color& weight, AovSample& aov) {

@@ -141,7 +141,10 @@ class PathIntegrator final : public Integrator {
   //  - on the BSDF sample there: the vertex's albedo is the sample's weight f |cos| / pdf, clamped
   //    to [0, 1] (0 when nothing was sampled): its directional albedo's one-sample estimate, which
   //    the film's mean makes the albedo itself (for a Lambertian surface, the reflectance exactly);
-  //  - on a miss before that vertex: no normal, and the environment's radiance (clamped) as albedo.
+  //  - on a miss before that vertex: no normal, and the environment's radiance (clamped) times the
+  //    chain's weight as albedo;
+  //  - where the path ends at that vertex (an emitter without a material, the depth limit, a black
+  //    texel), the albedo is settled on arrival.
   static void aovOnArrival(const PathState& path, const SurfaceHit& hit, bool scatters, AovSample& aov);
   static void aovOnSample(bool sampled, const Color& weight, AovSample& aov);
   static void aovOnMiss(const Scene& scene, const PathState& path, AovSample& aov);

@@ -59,11 +59,20 @@ RenderStats render(const Scene& scene, const Integrator& integrator, const Rende
                                 std::to_string(scene.camera().width()) + "x" +
                                 std::to_string(scene.camera().height()));
   CausticSplats splats;
-  // Adaptive sampling: the most samples any pixel's budget asks for, once the budgets are set.
-  const auto budgetEnd = [&] {
+  // Adaptive sampling: the most samples any pixel's budget asks for, once the budgets are set,
+  // and the samples pass p takes.
+  const auto largestBudget = [&] {
     return film.budgets().empty() ? uint32_t(options.spp)
-                                  : std::min(uint32_t(options.spp),
-                                             *std::max_element(film.budgets().begin(), film.budgets().end()));
+                                  : *std::max_element(film.budgets().begin(), film.budgets().end());
+  };
+  const auto budgetEnd = [&] { return std::min(uint32_t(options.spp), largestBudget()); };
+  const auto samplesOfPass = [&](int p) {
+    if (film.budgets().empty()) return pixels * uint64_t(passSamples(p));
+    const uint32_t offset = uint32_t(p) * uint32_t(passSpp);
+    uint64_t taken = 0;
+    for (uint32_t b : film.budgets())
+      taken += b > offset ? std::min<uint64_t>(b - offset, uint64_t(passSamples(p))) : 0;
+    return taken;
   };
   for (int p = firstPass; p < passes; ++p) {
     // The budget admits a pass if the previous one, run again, would end within it; the first
@@ -97,14 +106,8 @@ RenderStats render(const Scene& scene, const Integrator& integrator, const Rende
     if (traceCaustics) {
       // Under adaptive sampling, light paths in proportion to the samples the pass takes: a light
       // path's splats land anywhere, and most pixels are done.
-      double fraction = 1.0;
-      if (!film.budgets().empty()) {
-        uint64_t taken = 0;
-        for (uint32_t b : film.budgets())
-          taken += b > passOffset ? std::min<uint64_t>(b - passOffset, uint64_t(passSamples(p))) : 0;
-        fraction = double(taken) / double(pixels * uint64_t(passSamples(p)));
-      }
-      splats.reset(passSamples(p), width, height, fraction);
+      splats.reset(passSamples(p), width, height,
+                   double(samplesOfPass(p)) / double(pixels * uint64_t(passSamples(p))));
       PathStats traced;
       arena.execute([&] {
         integrator.traceCaustics(scene, options.seed, options.sampler, passFirstSample, passSamples(p),
@@ -160,20 +163,16 @@ RenderStats render(const Scene& scene, const Integrator& integrator, const Rende
       break;
     }
     lastPass = std::chrono::duration<double>(Clock::now() - passStart).count();
-    if (film.budgets().empty()) {
-      stats.samples += pixels * uint64_t(passSamples(p));
-    } else {
-      for (uint32_t b : film.budgets())
-        stats.samples += b > passOffset ? std::min<uint64_t>(b - passOffset, uint64_t(passSamples(p))) : 0;
-    }
+    stats.samples += samplesOfPass(p);
     stats.passes = p + 1;
     if (options.onPass) options.onPass(film, stats.passes);
   }
   progress.finish();
   if (options.targetRelativeError > 0.0) {
     stats.relativeError = film.relativeError();
+    // Adaptive: converged when every budget is spent, not when --spp cut the budgets short.
     stats.converged = options.adaptive
-                          ? !film.budgets().empty() && uint32_t(stats.passes * passSpp) >= budgetEnd()
+                          ? !film.budgets().empty() && uint32_t(stats.passes * passSpp) >= largestBudget()
                           : stats.relativeError <= options.targetRelativeError;
   }
   stats.seconds = std::chrono::duration<double>(Clock::now() - start).count();

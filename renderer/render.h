@@ -37,10 +37,11 @@ struct RenderOptions {
   // on the film alone, before every pass (the first of a resumed render's too), so a render
   // stopped and resumed ends at the same pass as one run through.
   double targetRelativeError = 0.0;
-  // Adaptive sampling (renderer/adaptive.h): targetRelativeError then applies to each pixel. Every
-  // pixel first takes the first whole passes holding at least `adaptivePilotSpp` samples; the film
-  // then gets each pixel's budget (Film::budgets, kept by checkpoints), and later passes sample a
-  // pixel only within it. The render ends when every budget is spent, or at `spp`.
+  // Adaptive sampling (renderer/adaptive.h): every pixel first takes the first whole passes holding
+  // at least `adaptivePilotSpp` samples; the film then gets each pixel's budget (Film::budgets,
+  // kept by checkpoints), sized so that the image's relative error reaches targetRelativeError,
+  // and later passes sample a pixel only within it. The render ends when every budget is spent,
+  // or at `spp`.
   bool adaptive = false;
   int adaptivePilotSpp = 16;
   // Called after each completed pass with the number of passes the film now holds.

@@ -82,6 +82,16 @@ TEST(Aovs, ALambertianPlaneGivesItsReflectanceNormalAndDistance) {
   // AOVs change nothing in the colour.
   const Film plain = renderAovs(scene, AovSet{}, 8);
   EXPECT_EQ(plain.sums(), film.sums());
+  // A path that ends at the surface at the depth limit still gives its albedo (--max-depth 1).
+  Scene shallow = loadText(dir, R"({"image": {"width": 4, "height": 4},
+    "camera": {"type": "orthographic", "origin": [0, 0, 5], "target": [0, 0, 0], "up": [0, 1, 0], "half_height": 1},
+    "render": {"background": 1, "max_depth": 1},
+    "materials": {"grey": {"type": "diffuse", "reflectance": [0.4, 0.5, 0.6]}},
+    "shapes": [{"type": "quad", "material": "grey",
+                "vertices": [[-2, -2, 0], [2, -2, 0], [2, 2, 0], [-2, 2, 0]]}]})");
+  const Film limited = renderAovs(shallow, kAll, 4);
+  const std::vector<ImageLayer> limitedLayers = limited.aovLayers();
+  for (float v : layer(limitedLayers, "albedo.R").pixels) EXPECT_GT(v, 0.39f);
 }
 
 // A unit sphere seen orthographically: each pixel's normal and depth are the sphere's at the

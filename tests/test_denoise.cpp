@@ -103,6 +103,11 @@ TEST(DenoiseCli, ADenoisedRenderIsCloserToTheReferenceAndKeepsTheNoisyOne) {
   for (size_t i = 0; i < a.rgb.size(); ++i) worst = std::max(worst, double(std::abs(a.rgb[i] - b.rgb[i])));
   EXPECT_LT(worst, 1e-3);
   EXPECT_EQ(second.channels.at("noisy.R"), exr.channels.at("noisy.R"));
+  // A denoised image is not a mean of samples: merge refuses it.
+  const test::CliResult merge =
+      test::runEmber("merge " + quoted(denoised) + " " + quoted(plain) + " -o " + quoted(dir.file("m.exr")));
+  EXPECT_EQ(merge.exitCode, 1);
+  EXPECT_NE(merge.output.find("denoised"), std::string::npos) << merge.output;
   // Denoised again, it starts from the noisy layer, not from the denoised colour.
   const std::string third = dir.file("t.exr");
   ASSERT_EQ(test::runEmber("denoise " + quoted(again) + " -o " + quoted(third) + " --threads 2").exitCode, 0);
