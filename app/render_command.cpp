@@ -324,16 +324,18 @@ int runRender(RenderArgs a) {
   options.timeBudgetSeconds = budget;
   if (a.untilRelerr) {
     // Each rank holds only its share of every pixel's samples: none could judge the whole.
-    if (cluster.distributed()) throw InputError("--until-relerr cannot be used under MPI");
+    if (cluster.distributed() && !a.adaptive)
+      throw InputError("--until-relerr cannot be used under MPI without --adaptive");
     options.targetRelativeError = *a.untilRelerr;
   }
   if (a.adaptive) {
     if (!a.untilRelerr)
       throw InputError("--adaptive needs --until-relerr X: the relative error the image is to reach");
-    if (cluster.distributed()) throw InputError("--adaptive cannot be used under MPI");
     options.adaptive = true;
+    // Under MPI each rank samples its own share adaptively, from its own pilot, to X sqrt(ranks):
+    // the ranks' independent images average to about X (docs/aovs.md).
+    if (cluster.distributed()) options.targetRelativeError *= std::sqrt(double(cluster.size()));
   } else if (setup.resumed && setup.resumed->adaptiveTarget > 0.0) {  // the checkpoint's settings
-    if (cluster.distributed()) throw InputError("--adaptive cannot be used under MPI");
     if (a.untilRelerr)
       throw InputError("--until-relerr: the checkpoint samples adaptively to " +
                        std::to_string(setup.resumed->adaptiveTarget) + "; resume it without");

@@ -102,6 +102,34 @@ TEST(Mpi, AovLayersEqualTheSingleProcessOnes) {
   }
 }
 
+// Adaptive sampling under MPI: each rank samples its share from its own pilot (16 samples per
+// pixel each), to the target times sqrt(ranks); the image agrees with one process's adaptive one
+// (the image means within 2%), and the spp layer adds the ranks' counts.
+TEST(Mpi, AdaptiveRanksSampleTheirSharesAndAgreeWithOneProcess) {
+  test::TempDir dir;
+  const std::string one = dir.file("one.exr"), two = dir.file("two.exr");
+  const std::string settings =
+      " --width 48 --height 40 --threads 1 -q --until-relerr 0.1 --adaptive --spp 1024";
+  ASSERT_EQ(test::runEmber("render '" + kScene + "' -o '" + one + "'" + settings).exitCode, 0);
+  const test::CliResult r =
+      runShell(mpirun(2) + "'" + EMBER_BINARY + "' render '" + kScene + "' -o '" + two + "'" + settings);
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  const ExrChannels a = readExrChannels(one), b = readExrChannels(two);
+  ASSERT_TRUE(b.has("spp"));
+  for (float n : b.channels.at("spp")) EXPECT_GE(n, 32.0f);
+  for (const char* c : {"R", "G", "B"}) {
+    double ma = 0.0, mb = 0.0;
+    for (float v : a.channels.at(c)) ma += v;
+    for (float v : b.channels.at(c)) mb += v;
+    EXPECT_NEAR(mb / ma, 1.0, 0.02) << c;
+  }
+  // --until-relerr alone is still refused: no rank could judge the whole image.
+  const test::CliResult alone = runShell(mpirun(2) + "'" + EMBER_BINARY + "' render '" + kScene + "' -o '" +
+                                         dir.file("x.exr") + "' -q --until-relerr 0.1");
+  EXPECT_NE(alone.exitCode, 0);
+  EXPECT_FALSE(std::filesystem::exists(dir.file("x.exr")));
+}
+
 TEST(Mpi, CheckpointedRanksResumeToTheSameImage) {
   test::TempDir dir;
   const std::string out = dir.file("np2.exr"), ckpt = dir.file("job.ckpt");
