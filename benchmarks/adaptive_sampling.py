@@ -6,7 +6,7 @@ Efficiency = 1 / (relMSE x render seconds); the gain is the adaptive render's ov
 one's. Prints a Markdown table.
 
   python3 benchmarks/adaptive_sampling.py --ember build/app/ember [--target 0.05] \\
-      [--gltf path/to/model.gltf ...] [--gltf-ref-spp 4096]
+      [--scenes cornell-area ...] [--gltf path/to/model.gltf ...] [--gltf-ref-spp 4096]
 """
 import argparse
 import os
@@ -35,13 +35,14 @@ def main():
     ap.add_argument("--ember", default="build/app/ember")
     ap.add_argument("--out", default="/tmp/ember-adaptive")
     ap.add_argument("--target", type=float, default=0.05)
+    ap.add_argument("--scenes", nargs="*", default=["cornell-area", "cornell-point", "shapes", "textured"])
     ap.add_argument("--gltf", nargs="*", default=[])
     ap.add_argument("--gltf-ref-spp", type=int, default=4096)
     ap.add_argument("--size", type=int, default=240, help="glTF image side")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
     cases = []
-    for name in os.environ.get("SCENES", "cornell-area cornell-point shapes textured").split():
+    for name in args.scenes:
         extra = ["--caustics", "path"] if name == "cornell-point" else []
         cases.append((name, os.path.join(ROOT, "scenes", name + ".json"), extra,
                       os.path.join(ROOT, "tests", "data", name, "reference.exr")))

@@ -5,7 +5,7 @@
 // scaled so that the image's relative error (Film::relativeError) reaches the target:
 //   n_i = ceil(sigma_i * mean_j(sigma_j) / target^2).
 // Giving each pixel the count that brings its own error to the target (n_i proportional to
-// sigma_i^2) would over-sample the noisiest pixels: it lost 15-30% efficiency against uniform
+// sigma_i^2) would over-sample the noisiest pixels: it lost 16-32% efficiency against uniform
 // sampling on the analytic scenes (docs/performance.md), where this rule gains.
 //
 // Unbiasedness: a pixel's budget is worked out from the other pixels' pilot samples only, never
