@@ -28,6 +28,7 @@ void put(std::string& out, const T& v) {
 
 template <typename T>
 void putArray(std::string& out, const std::vector<T>& v) {
+  if (v.empty()) return;  // an empty vector's data() may be null, which memcpy may not take
   out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
 }
 
@@ -45,6 +46,7 @@ class Reader {
   }
   template <typename T>
   void getArray(std::vector<T>& v, const char* what) {
+    if (v.empty()) return;  // an empty vector's data() may be null, which memcpy may not take
     need(v.size() * sizeof(T), what);
     std::memcpy(v.data(), bytes_.data() + at_, v.size() * sizeof(T));
     at_ += v.size() * sizeof(T);

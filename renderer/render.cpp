@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <mutex>
 #include <stdexcept>
 #include <string>
@@ -25,9 +26,7 @@ RenderStats render(const Scene& scene, const Integrator& integrator, const Rende
                    Film& film) {
   using Clock = std::chrono::steady_clock;
   const int width = film.width(), height = film.height();
-  const int tile = std::max(1, options.tileSize);
-  const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
-  const int tiles = tilesX * tilesY;
+  const int baseTile = std::max(1, options.tileSize);
   const int threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
   const int passSpp = std::max(1, options.passSpp);
   const int passes = passCount(options.spp, passSpp);
@@ -42,8 +41,8 @@ RenderStats render(const Scene& scene, const Integrator& integrator, const Rende
   std::mutex statsMutex;
   ProgressReporter progress(remaining, 1, options.progress);
   // Backups of each tile's pixels before it adds a pass, to take an interrupted pass back.
-  std::vector<Film::TileBackup> backups(options.stop ? size_t(tiles) : 0);
-  std::vector<uint8_t> rendered(static_cast<size_t>(tiles), 0);
+  std::vector<Film::TileBackup> backups;
+  std::vector<uint8_t> rendered;
   const auto stopRequested = [&] { return options.stop && options.stop->load(std::memory_order_relaxed); };
 
   const auto start = Clock::now();
@@ -101,7 +100,19 @@ RenderStats render(const Scene& scene, const Integrator& integrator, const Rende
       break;
     }
     const auto passStart = Clock::now();
-    std::fill(rendered.begin(), rendered.end(), 0);
+    // Tiles of the usual size; under adaptive sampling, as much larger as the pass samples fewer
+    // pixels, so that a tile still fills the wave driver's waves (the image is the same for any
+    // tile size).
+    int tile = baseTile;
+    if (!film.budgets().empty()) {
+      const double share = double(samplesOfPass(p)) / double(pixels * uint64_t(passSamples(p)));
+      tile = int(std::min(256.0, double(baseTile) / std::sqrt(std::max(share, 1e-4))));
+      tile = std::max(tile, baseTile);
+    }
+    const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
+    const int tiles = tilesX * tilesY;
+    rendered.assign(size_t(tiles), 0);
+    if (options.stop) backups.resize(size_t(tiles));
     const uint64_t passFirstSample = options.firstSample + uint64_t(p) * uint64_t(passSpp);
     if (traceCaustics) {
       // Under adaptive sampling, light paths in proportion to the samples the pass takes: a light
