@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The whole test suite, from a fresh machine: Debian packages, a Release build (profile-guided, as
 # scripts/demo.sh builds it: cmake/Pgo.cmake) and every test
-# (unit, statistical, whole-image comparisons, MPI with 2 and 3 ranks), then an ASan+UBSan build
+# (unit, statistical, whole-image comparisons, MPI with 2 and 3 ranks), the Python module's pytest
+# suite in the repository's .venv, then an ASan+UBSan build
 # with Clang of the whole tree running the unit tests, then a short run of each libFuzzer target (fuzz/run.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -11,6 +12,12 @@ jobs=$(nproc)
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DEMBER_PGO=ON >/dev/null
 cmake --build build -j "$jobs"
 ctest --test-dir build --output-on-failure -j "$jobs"
+
+# The Python module (pyproject.toml), built into the repository's .venv, and its pytest suite.
+[ -x .venv/bin/pip ] || python3 -m venv .venv
+.venv/bin/pip install -q --disable-pip-version-check pytest OpenEXR
+.venv/bin/pip install -q --disable-pip-version-check -Ccmake.define.EMBER_LTO=OFF .
+EMBER_BINARY="$PWD/build/app/ember" .venv/bin/python -m pytest -q python/tests
 
 # The sanitizer build uses Clang, so that the whole tree, tests included, builds with both compilers.
 if [ "${EMBER_SKIP_SANITIZERS:-0}" != 1 ]; then

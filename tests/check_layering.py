@@ -2,7 +2,7 @@
 """Fails when a source folder includes a folder above it in the architecture.
 
 The layers, bottom-up: core <- accel <- materials <- renderer <- packet (batched tracing)
-<- io <- denoise <- checkpoint <- distributed <- app
+<- io <- denoise <- checkpoint <- distributed <- app <- python
 (<- fuzz). A folder may include its own headers and those of the layers below it, never
 those above: that keeps the build a DAG and the reading order from scene file to EXR straight.
 """
@@ -10,7 +10,7 @@ import pathlib
 import re
 import sys
 
-ORDER = ["core", "accel", "materials", "renderer", "packet", "io", "denoise", "checkpoint", "distributed", "app", "fuzz"]
+ORDER = ["core", "accel", "materials", "renderer", "packet", "io", "denoise", "checkpoint", "distributed", "app", "python", "fuzz"]
 ALLOWED = {layer: set(ORDER[: i + 1]) for i, layer in enumerate(ORDER)}
 
 root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else ".")
