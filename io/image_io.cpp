@@ -123,15 +123,36 @@ std::vector<std::string> exrColourChannels(const Imf::ChannelList& channels) {
   return {};
 }
 
+// An EXR opened for reading, its header checked first (limitOpenExr, checkExrAttributeSizes), and
+// its data window's size checked.
+struct OpenedExr {
+  Imf::InputFile file;
+  Imath::Box2i window;
+  int64_t width, height;
+  explicit OpenedExr(const std::string& path)
+      : file((limitOpenExr(), checkExrAttributeSizes(path), path.c_str())),
+        window(file.header().dataWindow()),
+        width(int64_t(window.max.x) - window.min.x + 1),
+        height(int64_t(window.max.y) - window.min.y + 1) {
+    checkSize(path, width, height);
+  }
+};
+
+// The string attributes of an open EXR's header (its ember:* metadata among them).
+Metadata stringAttributes(const Imf::Header& header) {
+  Metadata out;
+  for (auto it = header.begin(); it != header.end(); ++it)
+    if (const auto* a = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
+      out.emplace_back(it.name(), a->value());
+  return out;
+}
+
 RawPixels readExr(const std::string& path) {
   try {
-    limitOpenExr();
-    checkExrAttributeSizes(path);
-    Imf::InputFile file(path.c_str());
-    const Imath::Box2i window = file.header().dataWindow();
-    const int64_t width = int64_t(window.max.x) - window.min.x + 1,
-                  height = int64_t(window.max.y) - window.min.y + 1;
-    checkSize(path, width, height);
+    OpenedExr exr(path);
+    Imf::InputFile& file = exr.file;
+    const Imath::Box2i window = exr.window;
+    const int64_t width = exr.width, height = exr.height;
     const std::vector<std::string> names = exrColourChannels(file.header().channels());
     if (names.empty()) throw InputError(path + ": image has no channels");
     RawPixels raw{int(width), int(height), int(names.size()), false, {}};
@@ -330,12 +351,8 @@ Metadata readStringMetadata(const std::string& path) {
   try {
     limitOpenExr();
     checkExrAttributeSizes(path);
-    Imf::InputFile file(path.c_str());
-    Metadata out;
-    for (auto it = file.header().begin(); it != file.header().end(); ++it)
-      if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
-        out.emplace_back(it.name(), s->value());
-    return out;
+    const Imf::InputFile file(path.c_str());
+    return stringAttributes(file.header());
   } catch (const std::exception& e) {
     throw InputError(path + ": cannot read image: " + e.what());
   }
@@ -384,13 +401,10 @@ ExrChannels readExrChannels(const std::string& path) {
   checkExists(path);
   if (!Imf::isOpenExrFile(path.c_str())) throw InputError(path + ": not an OpenEXR file");
   try {
-    limitOpenExr();
-    checkExrAttributeSizes(path);
-    Imf::InputFile file(path.c_str());
-    const Imath::Box2i window = file.header().dataWindow();
-    const int64_t width = int64_t(window.max.x) - window.min.x + 1,
-                  height = int64_t(window.max.y) - window.min.y + 1;
-    checkSize(path, width, height);
+    OpenedExr exr(path);
+    Imf::InputFile& file = exr.file;
+    const Imath::Box2i window = exr.window;
+    const int64_t width = exr.width, height = exr.height;
     ExrChannels out;
     out.width = int(width);
     out.height = int(height);
@@ -405,9 +419,7 @@ ExrChannels readExrChannels(const std::string& path) {
     }
     file.setFrameBuffer(frame);
     file.readPixels(window.min.y, window.max.y);
-    for (auto it = file.header().begin(); it != file.header().end(); ++it)
-      if (const auto* a = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
-        out.metadata.emplace_back(it.name(), a->value());
+    out.metadata = stringAttributes(file.header());
     return out;
   } catch (const InputError&) {
     throw;
