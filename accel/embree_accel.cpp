@@ -119,6 +119,18 @@ uint32_t EmbreeAccel::addInstance(uint32_t prototype, const Mat4& toWorld) {
   return id;
 }
 
+void EmbreeAccel::replaceShape(uint32_t geomID, const Shape* shape) {
+  RTCGeometry geom = rtcGetGeometry(scene_, geomID);
+  static_cast<ShapeGeometry*>(rtcGetGeometryUserData(geom))->shape = shape;
+  rtcCommitGeometry(geom);
+}
+
+void EmbreeAccel::setInstanceTransform(uint32_t geomID, const Mat4& toWorld) {
+  RTCGeometry geom = rtcGetGeometry(scene_, geomID);
+  rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, &toWorld[0][0]);
+  rtcCommitGeometry(geom);
+}
+
 void EmbreeAccel::commit() {
   rtcCommitScene(scene_);
   const RTCError err = rtcGetDeviceError(device_);

@@ -65,6 +65,11 @@ class EmbreeAccel {
   uint32_t addPrototype(const TriangleMesh* mesh);
   uint32_t addInstance(uint32_t prototype, const Mat4& toWorld);
   bool hasInstances() const { return instances_ > 0; }
+  // Edits between commits: the shape a user geometry traces (which must keep its mask bit's
+  // meaning: Shape::flat and Shape::convexSide as before), and an instance's placement. The next
+  // commit() rebuilds only the BVHs of what changed (Embree tracks modified geometries).
+  void replaceShape(uint32_t geomID, const Shape* shape);
+  void setInstanceTransform(uint32_t geomID, const Mat4& toWorld);
   void commit();
 
   bool intersect(const Ray& ray, RawHit& hit, uint32_t mask = kAllRayMask) const;

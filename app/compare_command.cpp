@@ -3,11 +3,9 @@
 // not, 2 on bad input. The --json layout is documented in docs/compare.md.
 #include "app/commands.h"
 
-#include "io/flip.h"
+#include "io/image_comparison.h"
 #include "io/image_io.h"
-#include "io/image_metrics.h"
 #include "io/input_error.h"
-#include "io/tonemap.h"
 
 #include <nlohmann/json.hpp>
 
@@ -48,45 +46,35 @@ Image load(const std::string& path, const char* what) {
   }
 }
 
-void requireSameSize(const Image& a, const Image& b, const std::string& pathB) {
-  if (a.width != b.width || a.height != b.height)
-    throw InputError(pathB + ": size " + std::to_string(b.width) + "x" + std::to_string(b.height) +
-                     " differs from the image's " + std::to_string(a.width) + "x" + std::to_string(a.height));
-}
-
 int runCompare(const CompareArgs& a) {
   const Image image = load(a.image, "image");
   const Image reference = load(a.reference, "reference");
-  requireSameSize(image, reference, a.reference);
   std::optional<Image> refStderr, variance;
-  if (!a.refStderr.empty()) {
-    refStderr = load(a.refStderr, "--ref-stderr");
-    requireSameSize(image, *refStderr, a.refStderr);
+  if (!a.refStderr.empty()) refStderr = load(a.refStderr, "--ref-stderr");
+  if (!a.variance.empty()) variance = load(a.variance, "--variance");
+  ComparisonOptions options;
+  options.maxRelmse = a.maxRelmse;
+  options.maxFlip = a.maxFlip;
+  options.alpha = a.alpha;
+  options.variancePool = a.pool;
+  options.pixelsPerDegree = a.ppd;
+  options.ldr = a.ldr;
+  Comparison c;
+  try {
+    c = compareImages(image, reference, variance ? &*variance : nullptr, refStderr ? &*refStderr : nullptr,
+                      options);
+  } catch (const InputError& e) {
+    // Name the file whose size differs.
+    const std::string what = e.what();
+    const std::string file = what.rfind("reference stderr", 0) == 0 ? a.refStderr
+                             : what.rfind("variance", 0) == 0       ? a.variance
+                                                                    : a.reference;
+    throw InputError(file + ": " + what);
   }
-  if (!a.variance.empty()) {
-    variance = load(a.variance, "--variance");
-    requireSameSize(image, *variance, a.variance);
-  }
-
-  const ImageMetrics m = computeMetrics(image, reference);
-  // One tone curve for both images: the reference's (Reinhard 2002, as `ember tonemap`). With
-  // --ldr the inputs are display-referred already and FLIP sees them as they are.
-  float logAverage = 0.0f, white = 0.0f;
-  const Image refDisplay =
-      a.ldr ? reference : reinhardLinear(reference, ReinhardParams{}, &logAverage, &white);
-  ReinhardParams shared;
-  shared.white = white;
-  shared.logAverage = logAverage;
-  const Image imageDisplay = a.ldr ? image : reinhardLinear(image, shared);
-  const FlipResult flip = computeFlip(refDisplay, imageDisplay, a.ppd);
-
-  std::optional<PixelZTest> z;
-  if (variance && refStderr) z = pixelZTest(image, *variance, reference, *refStderr, a.alpha, a.pool);
-
-  bool passed = true;
-  if (a.maxRelmse && !(m.relmseAll <= *a.maxRelmse)) passed = false;
-  if (a.maxFlip && !(flip.mean <= *a.maxFlip)) passed = false;
-  if (z && !z->passed()) passed = false;
+  const ImageMetrics& m = c.metrics;
+  const FlipResult& flip = c.flip;
+  const std::optional<PixelZTest>& z = c.zTest;
+  const bool passed = c.passed;
 
   if (!a.heatmap.empty()) {
     std::vector<uint8_t> rgb8(size_t(image.width) * size_t(image.height) * 3);
@@ -98,33 +86,8 @@ int runCompare(const CompareArgs& a) {
   }
 
   if (a.json) {
-    auto arr = [](const std::array<double, 3>& v) { return nlohmann::json::array({v[0], v[1], v[2]}); };
-    nlohmann::json j = {
-        {"image", a.image},
-        {"reference", a.reference},
-        {"width", image.width},
-        {"height", image.height},
-        {"mean_image", arr(m.meanImage)},
-        {"mean_reference", arr(m.meanReference)},
-        {"mae", arr(m.mae)},
-        {"rmse", arr(m.rmse)},
-        {"relmse", arr(m.relmse)},
-        {"mae_all", m.maeAll},
-        {"rmse_all", m.rmseAll},
-        {"relmse_all", m.relmseAll},
-        {"flip_mean", flip.mean},
-        {"nonfinite_pixels", m.nonFinite},
-        {"ztest", nullptr},
-        {"criteria",
-         {{"max_relmse", a.maxRelmse ? nlohmann::json(*a.maxRelmse) : nlohmann::json(nullptr)},
-          {"max_flip", a.maxFlip ? nlohmann::json(*a.maxFlip) : nlohmann::json(nullptr)},
-          {"ztest", z.has_value()}}},
-        {"passed", passed},
-    };
-    if (z)
-      j["ztest"] = {{"alpha", z->alpha},    {"variance_pool", a.pool}, {"threshold", z->threshold},
-                    {"tests", z->tests},    {"rejected", z->rejected}, {"max_abs_z", z->maxAbsZ},
-                    {"passed", z->passed()}};
+    nlohmann::json j = {{"image", a.image}, {"reference", a.reference}};
+    j.update(comparisonJson(c, options, image.width, image.height));
     std::printf("%s\n", j.dump(2).c_str());
   } else {
     std::printf("image      %s (%dx%d)\nreference  %s\n", a.image.c_str(), image.width, image.height,

@@ -2,11 +2,24 @@
 
 #include "io/image_plugin.h"
 #include "io/scene_loader.h"
+#include "io/scene_summary.h"
+
+#include <cstdio>
 
 #include <map>
 #include <memory>
 
 namespace ember::cli {
+
+namespace {
+
+std::string fmt(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
+
+}  // namespace
 
 Runner addInfoCommand(CLI::App& app) {
   auto path = std::make_shared<std::string>();
@@ -20,63 +33,55 @@ Runner addInfoCommand(CLI::App& app) {
     LoadOptions options;
     options.variant = *variant;
     Scene scene = loadScene(*path, options);
-    const size_t punctualLights = scene.lights.size();  // point, spot, directional: before build() adds more
     scene.build();
-    std::map<std::string, int> byType;
-    int emitters = 0, twoSidedEmitters = 0;
-    for (const auto& s : scene.shapes) {
-      ++byType[std::string(s.shape->typeName())];
-      emitters += !isBlack(s.emission);
-      twoSidedEmitters += !isBlack(s.emission) && s.twoSidedEmission;
-    }
-    size_t emissiveTriangles = 0, twoSidedTriangles = 0;
-    for (const auto& m : scene.meshes) {
-      if (isBlack(m.emission)) continue;
-      emissiveTriangles += m.mesh->indices.size();
-      if (m.twoSidedEmission) twoSidedTriangles += m.mesh->indices.size();
-    }
-    const RenderSettings& rs = scene.settings;
-    const CameraParams& c = scene.cameraParams;
-    const Bounds b = scene.bounds();
+    const nlohmann::json info = sceneSummary(scene);
+    const auto& image = info["image"];
+    const auto& camera = info["camera"];
+    const auto vec = [](const nlohmann::json& v) {
+      return "(" + fmt(v[0].get<double>()) + ", " + fmt(v[1].get<double>()) + ", " + fmt(v[2].get<double>()) +
+             ")";
+    };
     std::printf("scene:      %s\n", path->c_str());
-    std::printf("image:      %d x %d, %d spp, max depth %d, Russian roulette from %d, seed %llu\n", rs.width,
-                rs.height, rs.spp, rs.maxDepth, rs.rrDepth, static_cast<unsigned long long>(rs.seed));
-    std::printf("camera:     origin (%g, %g, %g) target (%g, %g, %g) ", c.origin.x, c.origin.y, c.origin.z,
-                c.target.x, c.target.y, c.target.z);
-    if (c.projection == Projection::Orthographic)
-      std::printf("orthographic, half height %g\n", c.orthoHalfHeight);
+    std::printf("image:      %d x %d, %d spp, max depth %d, Russian roulette from %d, seed %llu\n",
+                image["width"].get<int>(), image["height"].get<int>(), image["spp"].get<int>(),
+                image["max_depth"].get<int>(), image["rr_depth"].get<int>(),
+                static_cast<unsigned long long>(image["seed"].get<uint64_t>()));
+    std::printf("camera:     origin %s target %s ", vec(camera["origin"]).c_str(),
+                vec(camera["target"]).c_str());
+    if (camera["projection"] == "orthographic")
+      std::printf("orthographic, half height %g\n", camera["half_height"].get<double>());
     else
-      std::printf("fov_y %g deg\n", c.fovYDeg);
+      std::printf("fov_y %g deg\n", camera["fov_y_deg"].get<double>());
     std::printf("shapes:     %zu", scene.shapes.size());
-    for (const auto& [type, n] : byType) std::printf("  %s %d", type.c_str(), n);
-    std::printf("\nmeshes:     %zu (%zu triangles", scene.meshes.size(), scene.triangleCount());
-    if (scene.uniqueTriangleCount() != scene.triangleCount())
-      std::printf("; %zu unique, the rest instances of them", scene.uniqueTriangleCount());
+    for (const auto& [type, n] : info["shapes"].items()) std::printf("  %s %d", type.c_str(), n.get<int>());
+    std::printf("\nmeshes:     %zu (%zu triangles", scene.meshes.size(), info["triangles"].get<size_t>());
+    if (info["unique_triangles"] != info["triangles"])
+      std::printf("; %zu unique, the rest instances of them", info["unique_triangles"].get<size_t>());
     std::printf(")\n");
+    const auto& lights = info["lights"];
     std::printf(
         "lights:     %zu punctual, %d area (%d two-sided), %zu emissive triangles (%zu two-sided), %s "
         "environment\n",
-        punctualLights, emitters, twoSidedEmitters, emissiveTriangles, twoSidedTriangles,
-        scene.environment() ? "1" : "no");
-    std::printf("strategy:   %s\n", std::string(strategyName(rs.strategy)).c_str());
-    const CausticTracer& caustics = scene.causticTracer();
-    if (!rs.traceCaustics || !caustics.enabled())
-      std::printf("caustics:   path-traced (%s)\n",
-                  rs.traceCaustics ? caustics.whyDisabled() : "render.caustic_tracing is off");
+        lights["punctual"].get<size_t>(), lights["area"].get<int>(), lights["area_two_sided"].get<int>(),
+        lights["emissive_triangles"].get<size_t>(), lights["emissive_triangles_two_sided"].get<size_t>(),
+        lights["environment"].get<bool>() ? "1" : "no");
+    std::printf("strategy:   %s\n", info["strategy"].get<std::string>().c_str());
+    const auto& caustics = info["caustics"];
+    if (!caustics["traced"].get<bool>())
+      std::printf("caustics:   path-traced (%s)\n", caustics["why_not"].get<std::string>().c_str());
     else
-      std::printf("caustics:   light-traced, %zu specular object(s)\n", caustics.casters().size());
-    std::printf("materials:  %zu", scene.materials.size());
-    for (size_t i = 0; i < scene.materials.size(); ++i)
-      std::printf("%s %s (%s)", i ? "," : "", scene.materialNames[i].c_str(),
-                  std::string(scene.materials[i]->typeName()).c_str());
+      std::printf("caustics:   light-traced, %zu specular object(s)\n", caustics["casters"].get<size_t>());
+    std::printf("materials:  %zu", info["materials"].size());
+    for (size_t i = 0; i < info["materials"].size(); ++i)
+      std::printf("%s %s (%s)", i ? "," : "", info["materials"][i]["name"].get<std::string>().c_str(),
+                  info["materials"][i]["type"].get<std::string>().c_str());
     if (!scene.materialVariants.empty()) {
       std::printf("\nvariants:   %zu", scene.materialVariants.size());
       for (size_t i = 0; i < scene.materialVariants.size(); ++i)
         std::printf("%s '%s'", i ? "," : "", scene.materialVariants[i].c_str());
       std::printf(" (--variant NAME)");
     }
-    std::printf("\nbounds:     (%g, %g, %g) - (%g, %g, %g)\n", b.lower.x, b.lower.y, b.lower.z, b.upper.x,
-                b.upper.y, b.upper.z);
+    std::printf("\nbounds:     %s - %s\n", vec(info["bounds"][0]).c_str(), vec(info["bounds"][1]).c_str());
     // Which reader image files go through (io/image_plugin.h); EXR and PFM are always read built in.
     if (const ImagePlugin* plugin = imagePlugin())
       std::printf("images:     %s\n", plugin->describe().c_str());

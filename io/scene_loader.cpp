@@ -35,12 +35,15 @@ bool isGltfPath(const std::string& path) {
   return ext == ".gltf" || ext == ".glb";
 }
 
-namespace {
-
 class JsonSceneLoader {
  public:
-  JsonSceneLoader(const std::string& path, Scene& scene)
-      : path_(path), baseDir_(fs::path(path).parent_path()), scene_(scene) {}
+  JsonSceneLoader(const std::string& path, Scene& scene, JsonSceneIndex* index = nullptr)
+      : path_(path), baseDir_(fs::path(path).parent_path()), scene_(scene), index_(index) {
+    // Entries read again for an edit refer to the materials the scene already has.
+    for (size_t i = 0; i < scene.materials.size(); ++i)
+      materials_[scene.materialNames[i]] = scene.materials[i].get();
+    if (const auto black = materials_.find("(black)"); black != materials_.end()) black_ = black->second;
+  }
 
   void load(const JsonNode& root) {
     root.allowKeys(
@@ -53,22 +56,39 @@ class JsonSceneLoader {
     if (auto shapes = root.find("shapes"))
       for (size_t i = 0; i < shapes->arraySize(); ++i) readShape((*shapes)[i]);
     if (auto lights = root.find("lights"))
-      for (size_t i = 0; i < lights->arraySize(); ++i) readLight((*lights)[i]);
+      for (size_t i = 0; i < lights->arraySize(); ++i) {
+        if (index_) index_->lights.push_back(scene_.lights.size());
+        scene_.lights.push_back(readLight((*lights)[i]));
+      }
   }
 
- private:
+  void readShape(const JsonNode& s) {
+    JsonSceneIndex::Range range;
+    if (s.has("type") && s.at("type").isString() && s.at("type").string() == "mesh") {
+      range = {true, scene_.meshes.size(), 0};
+      readShapeEntry(s);
+      range.count = scene_.meshes.size() - range.first;
+    } else {
+      range = {false, scene_.shapes.size(), 1};
+      scene_.shapes.push_back(*readShapeEntry(s));
+    }
+    if (index_) index_->shapes.push_back(range);
+  }
+
   void readImage(const JsonNode& n) {
     n.allowKeys({"width", "height"});
     if (n.has("width")) scene_.settings.width = n.at("width").integer(1, 16384);
     if (n.has("height")) scene_.settings.height = n.at("height").integer(1, 16384);
   }
 
-  void readCamera(const JsonNode& n) {
+  void readCamera(const JsonNode& n) { scene_.cameraParams = readCameraParams(n); }
+
+  CameraParams readCameraParams(const JsonNode& n) {
     n.allowKeys({"type", "origin", "target", "up", "fov_y_deg", "half_height"});
     const std::string type = n.has("type") ? n.at("type").string() : "pinhole";
     if (type != "pinhole" && type != "orthographic")
       n.at("type").fail("unknown camera type; valid types are: pinhole, orthographic");
-    CameraParams& c = scene_.cameraParams;
+    CameraParams c;
     if (type == "orthographic") {
       c.projection = Projection::Orthographic;
       c.orthoHalfHeight = n.at("half_height").positive();
@@ -86,8 +106,10 @@ class JsonSceneLoader {
     if (glm::length(glm::cross(glm::normalize(f), c.up)) < 1e-6f)
       (n.has("up") ? n.at("up") : n)
           .fail("up must not be parallel to the view direction (the default up is +y)");
+    return c;
   }
 
+ private:
   void readRender(const JsonNode& n) {
     n.allowKeys({"spp", "max_depth", "rr_depth", "seed", "background", "sampler", "strategy",
                  "caustic_tracing", "caustic_paths_per_pixel"});
@@ -224,6 +246,7 @@ class JsonSceneLoader {
     }
   }
 
+ public:
   std::unique_ptr<Material> readMaterial(const JsonNode& m) {
     const std::string type = m.at("type").string();
     if (type == "diffuse" || type == "lambertian") {
@@ -277,6 +300,7 @@ class JsonSceneLoader {
         "'; valid types are: diffuse (alias lambertian), phong, mirror, refraction, dielectric, mixed");
   }
 
+ private:
   const Material* materialFor(const JsonNode& s, bool emissive) {
     if (!s.has("material")) {
       if (emissive) return blackMaterial();
@@ -303,13 +327,15 @@ class JsonSceneLoader {
     return black_;
   }
 
+ public:
   static std::string shapeName(const JsonNode& s, const std::string& type) {
     if (s.has("id")) return s.at("id").string();
     if (s.has("name")) return s.at("name").string();
     return type;
   }
 
-  void readShape(const JsonNode& s) {
+  // The shape's entry; a mesh's entries go straight into the scene (nullopt).
+  std::optional<Scene::ShapeEntry> readShapeEntry(const JsonNode& s) {
     const std::string type = s.at("type").string();
     const Color emission = s.color("emission", Color(0.0f));
     auto common = [&](std::initializer_list<std::string_view> extra) {
@@ -369,16 +395,17 @@ class JsonSceneLoader {
       common({"file", "transform", "materials", "variant", "texture_filter"});
       if (s.has("flip_normals")) s.at("flip_normals").fail("not supported for meshes");
       readMesh(s, emission);
-      return;
+      return std::nullopt;
     } else {
       s.at("type").fail("unknown shape type '" + type +
                         "'; valid types are: sphere, disc, cylinder, cone, box, triangle, quad, mesh");
     }
     if (s.boolean("flip_normals", false)) shape = std::make_unique<FlippedShape>(std::move(shape));
-    scene_.shapes.push_back({shapeName(s, type), std::move(shape), materialFor(s, !isBlack(emission)),
-                             emission, s.boolean("two_sided", false)});
+    return Scene::ShapeEntry{shapeName(s, type), std::move(shape), materialFor(s, !isBlack(emission)),
+                             emission, s.boolean("two_sided", false)};
   }
 
+ private:
   static void checkKeys(const JsonNode& s, const std::vector<std::string_view>& keys) {
     s.requireObject();
     for (auto it = s.raw().begin(); it != s.raw().end(); ++it) {
@@ -468,37 +495,38 @@ class JsonSceneLoader {
     }
   }
 
-  void readLight(const JsonNode& l) {
+ public:
+  std::unique_ptr<Light> readLight(const JsonNode& l) {
     const std::string type = l.at("type").string();
     if (type == "point") {
       l.allowKeys({"type", "id", "name", "position", "intensity"});
-      scene_.lights.push_back(
-          std::make_unique<PointLight>(l.at("position").vec3(), l.at("intensity").color()));
-    } else if (type == "spot") {
+      return std::make_unique<PointLight>(l.at("position").vec3(), l.at("intensity").color());
+    }
+    if (type == "spot") {
       l.allowKeys({"type", "id", "name", "position", "direction", "intensity", "inner_deg", "outer_deg"});
       const float outer = l.positive("outer_deg", 45.0f), inner = l.nonNegative("inner_deg", 0.0f);
       if (!(inner < outer && outer <= 90.0f)) l.fail("expected 0 <= inner_deg < outer_deg <= 90");
-      scene_.lights.push_back(
-          std::make_unique<SpotLight>(l.at("position").vec3(), l.at("direction").direction(),
-                                      l.at("intensity").color(), glm::radians(inner), glm::radians(outer)));
-    } else if (type == "directional") {
+      return std::make_unique<SpotLight>(l.at("position").vec3(), l.at("direction").direction(),
+                                         l.at("intensity").color(), glm::radians(inner), glm::radians(outer));
+    }
+    if (type == "directional") {
       l.allowKeys({"type", "id", "name", "direction", "irradiance"});
       // `direction` is where the light travels (glTF's -z of the light node), so it arrives from -direction.
-      scene_.lights.push_back(
-          std::make_unique<DirectionalLight>(-l.at("direction").direction(), l.at("irradiance").color()));
-    } else {
-      l.at("type").fail("unknown light type '" + type + "'; valid types are: point, spot, directional");
+      return std::make_unique<DirectionalLight>(-l.at("direction").direction(), l.at("irradiance").color());
     }
+    l.at("type").fail("unknown light type '" + type + "'; valid types are: point, spot, directional");
   }
 
+ private:
   std::string path_;
   fs::path baseDir_;
   Scene& scene_;
+  JsonSceneIndex* index_;
   std::map<std::string, const Material*> materials_;
   const Material* black_ = nullptr;
 };
 
-}  // namespace
+namespace {}  // namespace
 
 std::shared_ptr<const ImageTexture> loadEnvironmentMap(const std::string& path, const Color& scale,
                                                        TextureFilter filter) {
@@ -573,13 +601,44 @@ Scene loadGltfScene(const std::string& path, const LoadOptions& load) {
 
 }  // namespace
 
-Scene loadJsonScene(const std::string& path) {
+Scene loadJsonScene(const std::string& path, JsonSceneIndex* index) {
   const nlohmann::json doc = JsonNode::parseFile(path);
   Scene scene;
   scene.sourcePath = path;
   scene.sourceFiles.push_back(path);
-  JsonSceneLoader(path, scene).load(JsonNode(doc, "", path));
+  JsonSceneLoader(path, scene, index).load(JsonNode(doc, "", path));
   return scene;
+}
+
+Scene loadJsonScene(const nlohmann::json& document, const std::string& name, JsonSceneIndex* index) {
+  Scene scene;
+  scene.sourcePath = name;
+  JsonSceneLoader(name, scene, index).load(JsonNode(document, "", name));
+  return scene;
+}
+
+JsonEntryReader::JsonEntryReader(Scene& scene, const std::string& file)
+    : file_(file), loader_(std::make_unique<JsonSceneLoader>(file, scene)) {}
+JsonEntryReader::~JsonEntryReader() = default;
+
+CameraParams JsonEntryReader::camera(const nlohmann::json& value) const {
+  return loader_->readCameraParams(JsonNode(value, "camera", file_));
+}
+
+std::unique_ptr<Material> JsonEntryReader::material(const nlohmann::json& value,
+                                                    const std::string& name) const {
+  return loader_->readMaterial(JsonNode(value, "materials." + name, file_));
+}
+
+Scene::ShapeEntry JsonEntryReader::shape(const nlohmann::json& value, const std::string& path) const {
+  const JsonNode node(value, path, file_);
+  if (node.isObject() && node.has("type") && node.at("type").isString() && node.at("type").string() == "mesh")
+    node.at("type").fail("a mesh entry cannot be read again into a built scene; load the scene again");
+  return *loader_->readShapeEntry(node);
+}
+
+std::unique_ptr<Light> JsonEntryReader::light(const nlohmann::json& value, const std::string& path) const {
+  return loader_->readLight(JsonNode(value, path, file_));
 }
 
 Scene loadScene(const std::string& path, const LoadOptions& options) {

@@ -5,6 +5,8 @@
 
 #include "renderer/scene.h"
 
+#include <nlohmann/json.hpp>
+
 #include <string>
 
 namespace ember {
@@ -16,8 +18,40 @@ struct LoadOptions {
   bool trilinearTextures = false;  // glTF files: filter their images trilinearly (--texture-filter)
 };
 
+// Where each entry of a JSON scene's "shapes" and "lights" arrays went in the Scene.
+struct JsonSceneIndex {
+  struct Range {
+    bool mesh = false;  // into Scene::meshes (a "mesh" entry: all its glTF primitives), else Scene::shapes
+    size_t first = 0, count = 0;
+  };
+  std::vector<Range> shapes;
+  std::vector<size_t> lights;  // into Scene::lights
+};
+
 Scene loadScene(const std::string& path, const LoadOptions& options = {});
-Scene loadJsonScene(const std::string& path);
+Scene loadJsonScene(const std::string& path, JsonSceneIndex* index = nullptr);
+// A JSON scene held in memory (the Python module's dicts): `name` stands for the file in error
+// messages, and its folder (none: the working directory) resolves the relative paths inside.
+Scene loadJsonScene(const nlohmann::json& document, const std::string& name, JsonSceneIndex* index = nullptr);
+
+class JsonSceneLoader;
+
+// Single entries of a JSON scene read again, with the loader's checks and error messages (naming
+// `file` and the entry's JSON path), to edit a loaded scene: materials named in a shape entry
+// must be the scene's. Texture files are read again; nothing else is.
+class JsonEntryReader {
+ public:
+  JsonEntryReader(Scene& scene, const std::string& file);
+  ~JsonEntryReader();
+  CameraParams camera(const nlohmann::json& value) const;
+  std::unique_ptr<Material> material(const nlohmann::json& value, const std::string& name) const;
+  Scene::ShapeEntry shape(const nlohmann::json& value, const std::string& path) const;  // not meshes
+  std::unique_ptr<Light> light(const nlohmann::json& value, const std::string& path) const;
+
+ private:
+  std::string file_;
+  std::unique_ptr<JsonSceneLoader> loader_;
+};
 
 bool isGltfPath(const std::string& path);
 

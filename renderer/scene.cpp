@@ -42,75 +42,74 @@ const Material* Scene::addMaterial(std::string name, std::unique_ptr<Material> m
   return materials.back().get();
 }
 
-void Scene::build() {
-  // Building again (after editing the scene) first drops the lights the last build derived.
-  if (accel_) lights.resize(loadedLightCount_);
-  loadedLightCount_ = lights.size();
-  environment_ = nullptr;
-  accel_ = std::make_unique<EmbreeAccel>();
-  static std::atomic<uint64_t> builds{0};
-  buildSerial_ = ++builds;
-  records_.clear();
-  instances_.clear();
-  bakedMeshes_.clear();
-  meshBytes_ = 0;
-  triangleLights_.clear();
-  std::vector<Light*> allLights;
-  for (auto& light : lights) allLights.push_back(light.get());
-
+Scene::GeometryKey Scene::geometryKey() const {
   // Embree has 32 mask bits: each goes to one flat shape or convex solid's boundary (Shape::flat,
   // Shape::convexSide), flat emitters first (their shadow rays skip them too), and any such
   // shapes past the 32nd are tested as before.
-  std::vector<uint32_t> ownBits(shapes.size(), 0u);
+  GeometryKey key;
+  key.ownBits.assign(shapes.size(), 0u);
   unsigned maskBits = 0;
   for (const bool flatEmitters : {true, false})
     for (size_t i = 0; i < shapes.size(); ++i) {
       const Shape& s = *shapes[i].shape;
       const bool flatEmitter = s.flat() && !isBlack(shapes[i].emission);
       if (maskBits < 32 && flatEmitter == flatEmitters && (s.flat() || s.convexSide() != 0))
-        ownBits[i] = 1u << maskBits++;
+        key.ownBits[i] = 1u << maskBits++;
     }
+  // Analytic shapes have no surface maps and AreaLight's radiance is uniform, so the material
+  // is the only reader of their UV (were emission textures added, they would read it too).
+  for (const ShapeEntry& entry : shapes)
+    key.readsUv.push_back(uvOnEveryHit || !entry.material || entry.material->readsUv());
+  for (const MeshEntry& entry : meshes) key.baked.push_back(entry.toWorld && !isBlack(entry.emission));
+  return key;
+}
+
+void Scene::build() {
+  // Building again (after editing the scene) first drops the lights the last build derived.
+  if (accel_) lights.resize(loadedLightCount_);
+  loadedLightCount_ = lights.size();
+  buildGeometry();
+  deriveShading();
+}
+
+void Scene::buildGeometry() {
+  accel_ = std::make_unique<EmbreeAccel>();
+  builtKey_ = geometryKey();
+  records_.clear();
+  instances_.clear();
+  bakedMeshes_.clear();
+  meshBytes_ = 0;
+  shapeGeomIDs_.assign(shapes.size(), ~0u);
+  meshGeomIDs_.assign(meshes.size(), ~0u);
   for (size_t i = 0; i < shapes.size(); ++i) {
     ShapeEntry& entry = shapes[i];
-    // Analytic shapes have no surface maps and AreaLight's radiance is uniform, so the material
-    // is the only reader of their UV (were emission textures added, they would read it too).
-    const bool readsUv = uvOnEveryHit || !entry.material || entry.material->readsUv();
-    const bool emits = !isBlack(entry.emission);
-    const uint32_t ownBit = ownBits[i];
-    const uint32_t id = accel_->addShape(entry.shape.get(), readsUv, ownBit ? ownBit : kAllRayMask);
-    GeometryRecord rec{entry.shape.get(), nullptr,        entry.material,
-                       nullptr,           entry.emission, entry.twoSidedEmission};
-    rec.readsUv = readsUv;
+    const uint32_t ownBit = builtKey_.ownBits[i];
+    const uint32_t id =
+        accel_->addShape(entry.shape.get(), builtKey_.readsUv[i], ownBit ? ownBit : kAllRayMask);
+    GeometryRecord rec;
+    rec.shape = entry.shape.get();
+    rec.readsUv = builtKey_.readsUv[i];
     rec.uvDensity = entry.shape->uvDensity();
-    rec.deltaLobes = entry.material && entry.material->hasDeltaLobes();
     const bool flat = entry.shape->flat();
     const int convex = entry.shape->convexSide();
     rec.maskFront = flat || convex > 0 ? ~ownBit : kAllRayMask;
     rec.maskBack = flat || convex < 0 ? ~ownBit : kAllRayMask;
-    if (emits) {
-      lights.push_back(
-          std::make_unique<AreaLight>(entry.shape.get(), entry.emission, entry.twoSidedEmission));
-      // Shadow rays skip flat emitters only: one aimed at a curved emitter's far side, sampled by
-      // area from close by, must still be blocked by its near side.
-      lights.back()->shadowMask = flat ? ~ownBit : kAllRayMask;
-      allLights.push_back(lights.back().get());
-      rec.light = lights.back().get();
-    }
     if (records_.size() <= id) records_.resize(id + 1);
     records_[id] = rec;
+    shapeGeomIDs_[i] = id;
   }
   std::unordered_map<const TriangleMesh*, uint32_t> prototypes;  // shared mesh -> its BVH
-  for (MeshEntry& entry : meshes) {
+  for (size_t j = 0; j < meshes.size(); ++j) {
+    MeshEntry& entry = meshes[j];
     if (entry.mesh->indices.empty()) continue;
     if (entry.maps && entry.maps->normalMap && entry.mesh->tangents.empty()) entry.mesh->generateTangents();
-    const bool emits = !isBlack(entry.emission);
     // The mesh as traced: the entry's own, or, for an emissive instance, whose every world triangle
     // is a light, a world-space copy.
     const TriangleMesh* mesh = entry.mesh.get();
     const MeshInstance* instance = nullptr;
     bool newData = true;  // whether this mesh's bytes are not counted yet
     uint32_t id;
-    if (entry.toWorld && emits) {
+    if (builtKey_.baked[j]) {
       bakedMeshes_.push_back(MeshInstance(mesh, *entry.toWorld).baked());
       mesh = bakedMeshes_.back().get();
       id = accel_->addMesh(mesh);
@@ -125,22 +124,11 @@ void Scene::build() {
       id = accel_->addMesh(mesh);
     }
     if (records_.size() <= id) records_.resize(id + 1);
-    GeometryRecord rec{nullptr,         mesh, entry.material, nullptr, entry.emission, entry.twoSidedEmission,
-                       entry.maps.get()};
+    GeometryRecord rec;
+    rec.mesh = mesh;
     rec.instance = instance;
-    rec.deltaLobes = entry.material && entry.material->hasDeltaLobes();
-    if (emits) {
-      // Every triangle of an emissive mesh is a light of its own, chosen by power like the rest.
-      rec.firstTriangleLight = int64_t(triangleLights_.size());
-      for (uint32_t prim = 0; prim < mesh->indices.size(); ++prim) {
-        lights.push_back(std::make_unique<TriangleLight>(mesh, prim, entry.emission,
-                                                         entry.maps ? entry.maps->emission.get() : nullptr,
-                                                         entry.twoSidedEmission));
-        allLights.push_back(lights.back().get());
-        triangleLights_.push_back(lights.back().get());
-      }
-    }
     records_[id] = rec;
+    meshGeomIDs_[j] = id;
     if (!newData) continue;
     const TriangleMesh& m = *mesh;
     meshBytes_ += m.indices.size() * sizeof(m.indices[0]) + m.positions.size() * sizeof(m.positions[0]) +
@@ -152,6 +140,54 @@ void Scene::build() {
   if (bounds_.empty()) {
     bounds_.extend(Vec3(-1.0f));
     bounds_.extend(Vec3(1.0f));
+  }
+}
+
+void Scene::deriveShading() {
+  lights.resize(loadedLightCount_);
+  environment_ = nullptr;
+  static std::atomic<uint64_t> builds{0};
+  buildSerial_ = ++builds;
+  triangleLights_.clear();
+  std::vector<Light*> allLights;
+  for (auto& light : lights) allLights.push_back(light.get());
+  for (size_t i = 0; i < shapes.size(); ++i) {
+    const ShapeEntry& entry = shapes[i];
+    GeometryRecord& rec = records_[shapeGeomIDs_[i]];
+    rec.material = entry.material;
+    rec.emission = entry.emission;
+    rec.twoSidedEmission = entry.twoSidedEmission;
+    rec.deltaLobes = entry.material && entry.material->hasDeltaLobes();
+    rec.light = nullptr;
+    if (isBlack(entry.emission)) continue;
+    lights.push_back(std::make_unique<AreaLight>(entry.shape.get(), entry.emission, entry.twoSidedEmission));
+    // Shadow rays skip flat emitters only: one aimed at a curved emitter's far side, sampled by
+    // area from close by, must still be blocked by its near side.
+    const uint32_t ownBit = builtKey_.ownBits[i];
+    lights.back()->shadowMask = entry.shape->flat() && ownBit ? ~ownBit : kAllRayMask;
+    allLights.push_back(lights.back().get());
+    rec.light = lights.back().get();
+  }
+  for (size_t j = 0; j < meshes.size(); ++j) {
+    if (meshGeomIDs_[j] == ~0u) continue;
+    const MeshEntry& entry = meshes[j];
+    GeometryRecord& rec = records_[meshGeomIDs_[j]];
+    rec.material = entry.material;
+    rec.emission = entry.emission;
+    rec.twoSidedEmission = entry.twoSidedEmission;
+    rec.maps = entry.maps.get();
+    rec.deltaLobes = entry.material && entry.material->hasDeltaLobes();
+    rec.firstTriangleLight = -1;
+    if (isBlack(entry.emission)) continue;
+    // Every triangle of an emissive mesh is a light of its own, chosen by power like the rest.
+    rec.firstTriangleLight = int64_t(triangleLights_.size());
+    for (uint32_t prim = 0; prim < rec.mesh->indices.size(); ++prim) {
+      lights.push_back(std::make_unique<TriangleLight>(rec.mesh, prim, entry.emission,
+                                                       entry.maps ? entry.maps->emission.get() : nullptr,
+                                                       entry.twoSidedEmission));
+      allLights.push_back(lights.back().get());
+      triangleLights_.push_back(lights.back().get());
+    }
   }
 
   if (environmentMap || !isBlack(background)) {
@@ -184,6 +220,64 @@ void Scene::build() {
                                  camera_.perspective(), settings.causticPathsPerPixel);
   if (causticTracer_.enabled())
     for (const Light* light : emitters) const_cast<Light*>(light)->causticTraced = true;
+}
+
+void Scene::update() {
+  if (!accel_ || geometryKey() != builtKey_ || meshes.size() != meshGeomIDs_.size() ||
+      shapes.size() != shapeGeomIDs_.size()) {
+    build();
+    return;
+  }
+  deriveShading();
+}
+
+void Scene::replaceShape(size_t i, std::unique_ptr<Shape> shape) {
+  const bool sameKind =
+      shape->flat() == shapes.at(i).shape->flat() && shape->convexSide() == shapes[i].shape->convexSide();
+  shapes[i].shape = std::move(shape);
+  if (!accel_) return;
+  if (!sameKind) {
+    build();
+    return;
+  }
+  GeometryRecord& rec = records_[shapeGeomIDs_[i]];
+  rec.shape = shapes[i].shape.get();
+  rec.uvDensity = rec.shape->uvDensity();
+  accel_->replaceShape(shapeGeomIDs_[i], rec.shape);
+  accel_->commit();
+  bounds_ = accel_->bounds();
+  update();
+}
+
+void Scene::setMeshTransform(size_t i, const Mat4& toWorld) {
+  MeshEntry& entry = meshes.at(i);
+  const bool instanced = entry.toWorld.has_value();
+  entry.toWorld = toWorld;
+  if (!accel_) return;
+  if (!instanced || builtKey_.baked[i] || meshGeomIDs_[i] == ~0u) {
+    build();
+    return;
+  }
+  GeometryRecord& rec = records_[meshGeomIDs_[i]];
+  for (auto& instance : instances_)
+    if (instance.get() == rec.instance) {
+      instance = std::make_unique<MeshInstance>(entry.mesh.get(), toWorld);
+      rec.instance = instance.get();
+    }
+  accel_->setInstanceTransform(meshGeomIDs_[i], toWorld);
+  accel_->commit();
+  bounds_ = accel_->bounds();
+  update();
+}
+
+void Scene::replaceMaterial(size_t i, std::unique_ptr<Material> material) {
+  const Material* old = materials.at(i).get();
+  for (ShapeEntry& entry : shapes)
+    if (entry.material == old) entry.material = material.get();
+  for (MeshEntry& entry : meshes)
+    if (entry.material == old) entry.material = material.get();
+  materials[i] = std::move(material);
+  if (accel_) update();
 }
 
 bool Scene::intersect(const Ray& ray, SurfaceHit& hit, uint32_t mask) const {

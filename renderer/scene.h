@@ -91,6 +91,25 @@ class Scene {
   // --- derived by build() -------------------------------------------------------------------
   void build();
   bool built() const { return accel_ != nullptr; }
+  // The lights a loader put in `lights` (point, spot, directional); build() appends the rest.
+  size_t loadedLightCount() const { return accel_ ? loadedLightCount_ : lights.size(); }
+  // Edits of a built scene (the Python module's Scene.set_*), each re-deriving only what depends
+  // on what changed, with the same result as build() from scratch:
+  // - update(), after editing cameraParams, settings, materials or the entries' material pointers,
+  //   emissions, `lights`' loaded entries, background or environment: the lights, records, light
+  //   sampler, camera and caustic tracer are derived again, the BVHs kept. Where an edit changes
+  //   what the acceleration structure holds (a shape's ray-mask bit moves when a flat shape starts
+  //   or stops emitting, a material starts reading texture coordinates, an instanced mesh starts
+  //   emitting and must be baked into world space) it builds everything.
+  // - replaceShape(): shape i traced by a new shape; Embree rebuilds only its user geometries' BVH
+  //   (all of them, if the new shape's flat/convex kind differs: its mask bit may move).
+  // - setMeshTransform(): mesh entry i placed by a new transform; only the instance level is
+  //   rebuilt where the entry is an instance, everything where it is baked or emissive.
+  void update();
+  void replaceShape(size_t i, std::unique_ptr<Shape> shape);
+  void setMeshTransform(size_t i, const Mat4& toWorld);
+  // Material i replaced: every entry that used it now uses the new one; then update().
+  void replaceMaterial(size_t i, std::unique_ptr<Material> material);
   // A number no other build() in this process has had (0: never built): what caches of facts
   // derived from a built scene key on, where a scene's address could be a rebuilt or new one's.
   uint64_t buildSerial() const { return buildSerial_; }
@@ -151,8 +170,21 @@ class Scene {
 
  private:
   std::vector<CausticCaster> findCausticCasters() const;
+  // What the acceleration structure holds beyond the geometry itself, from the entries: when it
+  // differs from the last build's, update() builds everything.
+  struct GeometryKey {
+    std::vector<uint32_t> ownBits;  // each shape's own ray-mask bit, 0 = none
+    std::vector<bool> readsUv;      // each shape's
+    std::vector<bool> baked;        // each mesh entry's: an instance traced as a world-space copy
+    bool operator==(const GeometryKey&) const = default;
+  };
+  GeometryKey geometryKey() const;
+  void buildGeometry();
+  void deriveShading();
 
   std::unique_ptr<EmbreeAccel> accel_;
+  GeometryKey builtKey_;
+  std::vector<uint32_t> shapeGeomIDs_, meshGeomIDs_;  // per entry; meshes without triangles: ~0u
   std::vector<const Light*> triangleLights_;
   size_t loadedLightCount_ = 0;
   std::vector<GeometryRecord> records_;  // indexed by Embree geomID
