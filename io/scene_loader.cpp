@@ -438,6 +438,7 @@ class JsonSceneLoader {
     return glm::rotate(Mat4(1.0f), glm::radians(r.at("degrees").number()), r.at("axis").direction());
   }
 
+ public:
   static Mat4 readTransform(const JsonNode& t) {
     t.allowKeys({"matrix", "translate", "rotate", "rotate_y_deg", "scale"});
     if (auto m = t.find("matrix")) {
@@ -461,6 +462,7 @@ class JsonSceneLoader {
     return out;
   }
 
+ private:
   void readMesh(const JsonNode& s, const Color& emission) {
     const JsonNode file = s.at("file");
     const fs::path meshPath = baseDir_ / file.string();
@@ -635,6 +637,10 @@ Scene::ShapeEntry JsonEntryReader::shape(const nlohmann::json& value, const std:
   if (node.isObject() && node.has("type") && node.at("type").isString() && node.at("type").string() == "mesh")
     node.at("type").fail("a mesh entry cannot be read again into a built scene; load the scene again");
   return *loader_->readShapeEntry(node);
+}
+
+Mat4 JsonEntryReader::transform(const nlohmann::json& value, const std::string& path) const {
+  return JsonSceneLoader::readTransform(JsonNode(value, path, file_));
 }
 
 std::unique_ptr<Light> JsonEntryReader::light(const nlohmann::json& value, const std::string& path) const {

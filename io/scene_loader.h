@@ -47,6 +47,7 @@ class JsonEntryReader {
   std::unique_ptr<Material> material(const nlohmann::json& value, const std::string& name) const;
   Scene::ShapeEntry shape(const nlohmann::json& value, const std::string& path) const;  // not meshes
   std::unique_ptr<Light> light(const nlohmann::json& value, const std::string& path) const;
+  Mat4 transform(const nlohmann::json& value, const std::string& path) const;  // a mesh entry's "transform"
 
  private:
   std::string file_;

@@ -249,25 +249,27 @@ void Scene::replaceShape(size_t i, std::unique_ptr<Shape> shape) {
   update();
 }
 
-void Scene::setMeshTransform(size_t i, const Mat4& toWorld) {
-  MeshEntry& entry = meshes.at(i);
-  const bool instanced = entry.toWorld.has_value();
-  entry.toWorld = toWorld;
+void Scene::setMeshTransforms(const std::vector<std::pair<size_t, Mat4>>& placements) {
+  bool instancesOnly = accel_ != nullptr;
+  for (const auto& [i, toWorld] : placements) {
+    MeshEntry& entry = meshes.at(i);
+    instancesOnly = instancesOnly && entry.toWorld && !builtKey_.baked[i] && meshGeomIDs_[i] != ~0u;
+    entry.toWorld = toWorld;
+  }
   if (!accel_) return;
-  if (!instanced || builtKey_.baked[i] || meshGeomIDs_[i] == ~0u) {
+  if (!instancesOnly) {
     build();
     return;
   }
-  GeometryRecord& rec = records_[meshGeomIDs_[i]];
-  for (auto& instance : instances_)
-    if (instance.get() == rec.instance) {
-      instance = std::make_unique<MeshInstance>(entry.mesh.get(), toWorld);
-      rec.instance = instance.get();
-    }
-  accel_->setInstanceTransform(meshGeomIDs_[i], toWorld);
+  for (const auto& [i, toWorld] : placements) {
+    // The record keeps its instance's address: the instance is placed anew where it is.
+    *const_cast<MeshInstance*>(records_[meshGeomIDs_[i]].instance) =
+        MeshInstance(meshes[i].mesh.get(), toWorld);
+    accel_->setInstanceTransform(meshGeomIDs_[i], toWorld);
+  }
   accel_->commit();
   bounds_ = accel_->bounds();
-  update();
+  deriveShading();
 }
 
 void Scene::replaceMaterial(size_t i, std::unique_ptr<Material> material) {

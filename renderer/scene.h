@@ -103,11 +103,11 @@ class Scene {
   //   emitting and must be baked into world space) it builds everything.
   // - replaceShape(): shape i traced by a new shape; Embree rebuilds only its user geometries' BVH
   //   (all of them, if the new shape's flat/convex kind differs: its mask bit may move).
-  // - setMeshTransform(): mesh entry i placed by a new transform; only the instance level is
-  //   rebuilt where the entry is an instance, everything where it is baked or emissive.
+  // - setMeshTransforms(): mesh entries placed anew ({entry, toWorld}); only the instance level is
+  //   rebuilt where every such entry is an instance, everything where one is baked or emissive.
   void update();
   void replaceShape(size_t i, std::unique_ptr<Shape> shape);
-  void setMeshTransform(size_t i, const Mat4& toWorld);
+  void setMeshTransforms(const std::vector<std::pair<size_t, Mat4>>& placements);
   // Material i replaced: every entry that used it now uses the new one; then update().
   void replaceMaterial(size_t i, std::unique_ptr<Material> material);
   // A number no other build() in this process has had (0: never built): what caches of facts

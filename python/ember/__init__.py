@@ -2,8 +2,13 @@
 
     import ember
     scene = ember.load("scenes/cornell-area.json")
-    image = scene.render(spp=64)   # numpy float32, (height, width, 3), linear radiance
+    image = scene.render(spp=64)          # float32 (height, width, 3), linear radiance
+    scene.set_camera(fov=30)              # edit, then render again: only the camera is rebuilt
+    ember.write_exr("out.exr", scene.render(spp=64))
 """
-from ._ember import Scene, SceneError, load
+from ._ember import SceneError
+from .image import Image, compare, png_bytes, read_exr, tonemap, write_exr
+from .scene import RenderInterrupted, Scene, load
 
-__all__ = ["Scene", "SceneError", "load"]
+__all__ = ["Image", "RenderInterrupted", "Scene", "SceneError", "compare", "load", "png_bytes", "read_exr",
+           "tonemap", "write_exr"]
