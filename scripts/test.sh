@@ -15,9 +15,11 @@ ctest --test-dir build --output-on-failure -j "$jobs"
 
 # The Python module (pyproject.toml), built into the repository's .venv, and its pytest suite.
 [ -x .venv/bin/pip ] || python3 -m venv .venv
-.venv/bin/pip install -q --disable-pip-version-check pytest OpenEXR
+.venv/bin/pip install -q --disable-pip-version-check pytest OpenEXR matplotlib
 .venv/bin/pip install -q --disable-pip-version-check -Ccmake.define.EMBER_LTO=OFF .
 EMBER_BINARY="$PWD/build/app/ember" .venv/bin/python -m pytest -q python/tests
+# The examples run as a user would run them, and check what they show.
+.venv/bin/python examples/ior_sweep.py --out build/examples/ior-sweep
 
 # The sanitizer build uses Clang, so that the whole tree, tests included, builds with both compilers.
 if [ "${EMBER_SKIP_SANITIZERS:-0}" != 1 ]; then

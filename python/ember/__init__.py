@@ -10,5 +10,9 @@ from ._ember import SceneError
 from .image import Image, compare, png_bytes, read_exr, tonemap, write_exr
 from .scene import RenderInterrupted, Scene, load
 
+# Shown as ember.Image, ember.Scene, ... in tracebacks and reprs, as they are imported.
+for _public in (Image, RenderInterrupted, Scene):
+    _public.__module__ = __name__
+
 __all__ = ["Image", "RenderInterrupted", "Scene", "SceneError", "compare", "load", "png_bytes", "read_exr",
            "tonemap", "write_exr"]
