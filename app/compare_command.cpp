@@ -46,12 +46,25 @@ Image load(const std::string& path, const char* what) {
   }
 }
 
+void requireSameSize(const Image& a, const Image& b, const std::string& pathB) {
+  if (a.width != b.width || a.height != b.height)
+    throw InputError(pathB + ": size " + std::to_string(b.width) + "x" + std::to_string(b.height) +
+                     " differs from the image's " + std::to_string(a.width) + "x" + std::to_string(a.height));
+}
+
 int runCompare(const CompareArgs& a) {
   const Image image = load(a.image, "image");
   const Image reference = load(a.reference, "reference");
+  requireSameSize(image, reference, a.reference);
   std::optional<Image> refStderr, variance;
-  if (!a.refStderr.empty()) refStderr = load(a.refStderr, "--ref-stderr");
-  if (!a.variance.empty()) variance = load(a.variance, "--variance");
+  if (!a.refStderr.empty()) {
+    refStderr = load(a.refStderr, "--ref-stderr");
+    requireSameSize(image, *refStderr, a.refStderr);
+  }
+  if (!a.variance.empty()) {
+    variance = load(a.variance, "--variance");
+    requireSameSize(image, *variance, a.variance);
+  }
   ComparisonOptions options;
   options.maxRelmse = a.maxRelmse;
   options.maxFlip = a.maxFlip;
@@ -59,18 +72,8 @@ int runCompare(const CompareArgs& a) {
   options.variancePool = a.pool;
   options.pixelsPerDegree = a.ppd;
   options.ldr = a.ldr;
-  Comparison c;
-  try {
-    c = compareImages(image, reference, variance ? &*variance : nullptr, refStderr ? &*refStderr : nullptr,
-                      options);
-  } catch (const InputError& e) {
-    // Name the file whose size differs.
-    const std::string what = e.what();
-    const std::string file = what.rfind("reference stderr", 0) == 0 ? a.refStderr
-                             : what.rfind("variance", 0) == 0       ? a.variance
-                                                                    : a.reference;
-    throw InputError(file + ": " + what);
-  }
+  const Comparison c = compareImages(image, reference, variance ? &*variance : nullptr,
+                                     refStderr ? &*refStderr : nullptr, options);
   const ImageMetrics& m = c.metrics;
   const FlipResult& flip = c.flip;
   const std::optional<PixelZTest>& z = c.zTest;

@@ -27,7 +27,7 @@ os.makedirs(args.out, exist_ok=True)
 
 # %% The scene: a glass ball over a white floor, a small area light straight above.
 RADIUS, HEIGHT, LAMP = 0.5, 1.2, 5.0
-scene = ember.load({
+document = {
     "image": {"width": 160, "height": 120},
     "camera": {"origin": [0.0, 1.4, 4.0], "target": [0.0, 0.35, 0.0], "fov_y_deg": 35},
     "render": {"seed": 7},
@@ -43,7 +43,8 @@ scene = ember.load({
         {"id": "lamp", "type": "quad", "material": "black", "emission": 400,
          "vertices": [[-0.1, LAMP, -0.1], [0.1, LAMP, -0.1], [0.1, LAMP, 0.1], [-0.1, LAMP, 0.1]]},
     ],
-})
+}
+scene = ember.load(document)
 
 # %% Which pixels see the floor right under the ball: from the position AOV of one render.
 _, aovs = scene.render(spp=4, aovs=["position"])
@@ -60,7 +61,9 @@ for n in iors:
     energy.append(float(image[under].mean()))
     if n in (1.0, 1.2, 1.5):
         ember.write_exr(os.path.join(args.out, f"ior-{n:.2f}.exr"), image)
-baseline = energy[0]  # n = 1: the ball bends nothing and reflects nothing, as if absent
+# The floor without the ball: what its light is measured against.
+no_ball = dict(document, shapes=[s for s in document["shapes"] if s.get("id") != "ball"])
+baseline = float(ember.load(no_ball).render(spp=args.spp)[under].mean())
 gain = [e / baseline for e in energy]
 
 with open(os.path.join(args.out, "ior-sweep.csv"), "w") as f:
@@ -92,6 +95,6 @@ except ImportError:
 
 # %% The checks a reader would make: n = 1 changes nothing; the ball focuses up to several times
 # the light there, most a little below the paraxial n.
-assert abs(gain[0] - 1.0) < 1e-6
+assert abs(gain[0] - 1.0) < 0.05, gain[0]  # n = 1 bends and reflects nothing: as if absent
 peak = iors[int(np.argmax(gain))]
 assert max(gain) > 3.0 and 1.15 <= peak <= 1.45, (peak, max(gain))

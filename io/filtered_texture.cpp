@@ -36,6 +36,14 @@ std::string filteredTextureFailure() {
   return firstFailure;
 }
 
+std::string takeFilteredTextureFailure() {
+  std::lock_guard<std::mutex> lock(failureMutex);
+  std::string failure = std::move(firstFailure);
+  firstFailure.clear();
+  anyFailure.store(false);
+  return failure;
+}
+
 FilteredImageTexture::FilteredImageTexture(const ImagePlugin& plugin, const std::string& name,
                                            const void* handle, const ImagePlugin::TextureFile& info,
                                            TextureWrap wrap, const Color& scale)

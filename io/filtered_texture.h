@@ -18,6 +18,8 @@ namespace ember {
 // a texture file that disappears or changes while a render reads it from the texture cache. A
 // lookup that fails returns black; the render command then reports this and writes nothing.
 std::string filteredTextureFailure();
+// The same, and forgets it: a process that renders again (the Python module) reports each render's.
+std::string takeFilteredTextureFailure();
 
 class FilteredImageTexture final : public Texture {
  public:

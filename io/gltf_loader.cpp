@@ -83,7 +83,7 @@ class GltfImporter {
     countPlacements();
     std::vector<int> stack;
     const size_t firstMesh = scene_.meshes.size();
-    for (int root : roots) visit(root, options_.transform, stack);
+    for (int root : roots) visit(root, Mat4(1.0f), stack);
     makePointsAndLines(firstMesh);
     scene_.materialVariants.insert(scene_.materialVariants.end(), result_.variants.begin(),
                                    result_.variants.end());
@@ -337,13 +337,17 @@ class GltfImporter {
     return m;
   }
 
+  // `parent`: where the node's parent lies in the file; options_.transform places the file.
   void visit(int index, const Mat4& parent, std::vector<int>& stack) {
     const std::string where = "nodes[" + std::to_string(index) + "]";
     if (index < 0 || size_t(index) >= model_.nodes.size()) fail(where, "node index out of range");
     for (int s : stack)
       if (s == index) fail(where, "the node hierarchy contains a cycle");
     const tinygltf::Node& node = model_.nodes[size_t(index)];
-    const Mat4 world = parent * localMatrix(node);
+    const Mat4 inFile = parent * localMatrix(node);
+    // The loader's transform last, so that an edit placing the file anew (Scene::MeshEntry::inFile)
+    // computes each placement as a load of the edited scene does.
+    const Mat4 world = options_.transform * inFile;
     for (int i = 0; i < 16; ++i)
       if (!std::isfinite(world[i / 4][i % 4])) fail(where, "non-finite transform");
     if (node.camera >= 0 && !result_.camera && (options_.camera < 0 || node.camera == options_.camera))
@@ -354,11 +358,11 @@ class GltfImporter {
       if (size_t(node.mesh) >= model_.meshes.size()) fail(where + ".mesh", "mesh index out of range");
       const tinygltf::Mesh& mesh = model_.meshes[size_t(node.mesh)];
       for (size_t p = 0; p < mesh.primitives.size(); ++p)
-        readPrimitive(mesh.primitives[p], world,
+        readPrimitive(mesh.primitives[p], world, inFile,
                       "meshes[" + std::to_string(node.mesh) + "].primitives[" + std::to_string(p) + "]");
     }
     stack.push_back(index);
-    for (int child : node.children) visit(child, world, stack);
+    for (int child : node.children) visit(child, inFile, stack);
     stack.pop_back();
   }
 
@@ -698,7 +702,8 @@ class GltfImporter {
           ++placements_[geometryKey(prim)];
   }
 
-  void readPrimitive(const tinygltf::Primitive& prim, const Mat4& world, const std::string& where) {
+  void readPrimitive(const tinygltf::Primitive& prim, const Mat4& world, const Mat4& inFile,
+                     const std::string& where) {
     const int mode = prim.mode < 0 ? kModeTriangles : prim.mode;
     if (mode < kModePoints || mode > kModeFan)
       fail(where + ".mode", "unknown primitive mode " + std::to_string(mode));
@@ -750,8 +755,8 @@ class GltfImporter {
       toWorld = world;
     }
     if (!shared || surface.opacity) mesh->opacity = surface.opacity;
-    scene_.meshes.push_back(
-        {std::move(mesh), material, surface.emission, surface.maps, surface.doubleSided, toWorld});
+    scene_.meshes.push_back({std::move(mesh), material, surface.emission, surface.maps, surface.doubleSided,
+                             toWorld, toWorld ? std::optional<Mat4>(inFile) : std::nullopt});
   }
 
   std::shared_ptr<TriangleMesh> readTriangles(const tinygltf::Primitive& prim, int mode, const Mat4& world,

@@ -37,11 +37,14 @@ bool isGltfPath(const std::string& path) {
 
 class JsonSceneLoader {
  public:
-  JsonSceneLoader(const std::string& path, Scene& scene, JsonSceneIndex* index = nullptr)
+  // `materialsOf`: a scene whose materials the entries may name (entries read again for an edit
+  // go into a scratch scene but refer to the edited scene's materials).
+  JsonSceneLoader(const std::string& path, Scene& scene, JsonSceneIndex* index = nullptr,
+                  const Scene* materialsOf = nullptr)
       : path_(path), baseDir_(fs::path(path).parent_path()), scene_(scene), index_(index) {
-    // Entries read again for an edit refer to the materials the scene already has.
-    for (size_t i = 0; i < scene.materials.size(); ++i)
-      materials_[scene.materialNames[i]] = scene.materials[i].get();
+    if (!materialsOf) return;
+    for (size_t i = 0; i < materialsOf->materials.size(); ++i)
+      materials_[materialsOf->materialNames[i]] = materialsOf->materials[i].get();
     if (const auto black = materials_.find("(black)"); black != materials_.end()) black_ = black->second;
   }
 
@@ -619,9 +622,21 @@ Scene loadJsonScene(const nlohmann::json& document, const std::string& name, Jso
   return scene;
 }
 
-JsonEntryReader::JsonEntryReader(Scene& scene, const std::string& file)
-    : file_(file), loader_(std::make_unique<JsonSceneLoader>(file, scene)) {}
+JsonEntryReader::JsonEntryReader(const Scene& scene, const std::string& file)
+    : file_(file),
+      scratch_(std::make_unique<Scene>()),
+      loader_(std::make_unique<JsonSceneLoader>(file, *scratch_, nullptr, &scene)) {}
 JsonEntryReader::~JsonEntryReader() = default;
+
+void JsonEntryReader::adoptInto(Scene& scene) {
+  for (size_t i = 0; i < scratch_->materials.size(); ++i)
+    scene.addMaterial(scratch_->materialNames[i], std::move(scratch_->materials[i]));
+  scene.sourceFiles.insert(scene.sourceFiles.end(), scratch_->sourceFiles.begin(),
+                           scratch_->sourceFiles.end());
+  scene.filteredTextures = scene.filteredTextures || scratch_->filteredTextures;
+  scratch_ = std::make_unique<Scene>();
+  loader_ = std::make_unique<JsonSceneLoader>(file_, *scratch_, nullptr, &scene);
+}
 
 CameraParams JsonEntryReader::camera(const nlohmann::json& value) const {
   return loader_->readCameraParams(JsonNode(value, "camera", file_));

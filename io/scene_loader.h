@@ -38,10 +38,13 @@ class JsonSceneLoader;
 
 // Single entries of a JSON scene read again, with the loader's checks and error messages (naming
 // `file` and the entry's JSON path), to edit a loaded scene: materials named in a shape entry
-// must be the scene's. Texture files are read again; nothing else is.
+// must be the scene's. Texture files are read again; nothing else is. Reading changes nothing in
+// the scene: what an entry needs besides itself (an emitter's black material, its texture files)
+// waits here until adoptInto(), which the caller makes once every entry of an edit was read.
 class JsonEntryReader {
  public:
-  JsonEntryReader(Scene& scene, const std::string& file);
+  JsonEntryReader(const Scene& scene, const std::string& file);
+  void adoptInto(Scene& scene);
   ~JsonEntryReader();
   CameraParams camera(const nlohmann::json& value) const;
   std::unique_ptr<Material> material(const nlohmann::json& value, const std::string& name) const;
@@ -51,6 +54,7 @@ class JsonEntryReader {
 
  private:
   std::string file_;
+  std::unique_ptr<Scene> scratch_;
   std::unique_ptr<JsonSceneLoader> loader_;
 };
 

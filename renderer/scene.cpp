@@ -144,6 +144,16 @@ void Scene::buildGeometry() {
 }
 
 void Scene::deriveShading() {
+  // The environment light tabulates its map for sampling (milliseconds per megapixel): kept while
+  // what it was made from is unchanged. deriveShading adds it last.
+  std::unique_ptr<Light> environment;
+  if (environment_ && lights.size() > loadedLightCount_ && lights.back().get() == environment_ &&
+      builtEnvironment_.map == environmentMap && builtEnvironment_.rotateYDeg == environmentRotateYDeg &&
+      builtEnvironment_.background == background) {
+    environment = std::move(lights.back());
+    lights.pop_back();
+  }
+  builtEnvironment_ = {environmentMap, environmentRotateYDeg, background};
   lights.resize(loadedLightCount_);
   environment_ = nullptr;
   static std::atomic<uint64_t> builds{0};
@@ -191,7 +201,9 @@ void Scene::deriveShading() {
   }
 
   if (environmentMap || !isBlack(background)) {
-    if (environmentMap)
+    if (environment)
+      lights.push_back(std::move(environment));
+    else if (environmentMap)
       lights.push_back(std::make_unique<EnvironmentLight>(environmentMap, environmentRotateYDeg));
     else
       lights.push_back(std::make_unique<EnvironmentLight>(background));
@@ -253,7 +265,8 @@ void Scene::setMeshTransforms(const std::vector<std::pair<size_t, Mat4>>& placem
   bool instancesOnly = accel_ != nullptr;
   for (const auto& [i, toWorld] : placements) {
     MeshEntry& entry = meshes.at(i);
-    instancesOnly = instancesOnly && entry.toWorld && !builtKey_.baked[i] && meshGeomIDs_[i] != ~0u;
+    instancesOnly = instancesOnly && i < meshGeomIDs_.size() && entry.toWorld && !builtKey_.baked[i] &&
+                    meshGeomIDs_[i] != ~0u;
     entry.toWorld = toWorld;
   }
   if (!accel_) return;

@@ -59,6 +59,9 @@ class Scene {
     // it (MeshInstance::placeable must hold); build() then traces it as an Embree instance, so
     // entries sharing a mesh share one BVH (an emissive one is baked into world space instead).
     std::optional<Mat4> toWorld;
+    // Instances from a glTF file: where the file's nodes place this one, before the transform that
+    // places the file (toWorld = transform · inFile), so an edit can place the file anew.
+    std::optional<Mat4> inFile;
     Bounds worldBounds() const;
   };
 
@@ -96,7 +99,8 @@ class Scene {
   // Edits of a built scene (the Python module's Scene.set_*), each re-deriving only what depends
   // on what changed, with the same result as build() from scratch:
   // - update(), after editing cameraParams, settings, materials or the entries' material pointers,
-  //   emissions, `lights`' loaded entries, background or environment: the lights, records, light
+  //   emissions, `lights`' loaded entries (lights added after build() need build()), background
+  //   or environment: the lights, records, light
   //   sampler, camera and caustic tracer are derived again, the BVHs kept. Where an edit changes
   //   what the acceleration structure holds (a shape's ray-mask bit moves when a flat shape starts
   //   or stops emitting, a material starts reading texture coordinates, an instanced mesh starts
@@ -184,6 +188,11 @@ class Scene {
 
   std::unique_ptr<EmbreeAccel> accel_;
   GeometryKey builtKey_;
+  struct EnvironmentKey {
+    std::shared_ptr<const ImageTexture> map;
+    float rotateYDeg = 0.0f;
+    Color background{0.0f};
+  } builtEnvironment_;                                // what the environment light was made from
   std::vector<uint32_t> shapeGeomIDs_, meshGeomIDs_;  // per entry; meshes without triangles: ~0u
   std::vector<const Light*> triangleLights_;
   size_t loadedLightCount_ = 0;

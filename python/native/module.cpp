@@ -120,7 +120,9 @@ SceneHandle loadDocument(nb::handle document, const std::string& name) {
   return SceneHandle::fromDocument(std::move(json), name);
 }
 
-// Edits take the GIL's protection against a render of the same scene in another thread.
+// Edits take the GIL's protection against a render of the same scene in another thread: the
+// patch is converted first (which may run Python code, and so switch threads), then `busy` checked
+// and the scene changed without the GIL ever being let go in between.
 template <class F>
 void edit(SceneHandle& h, F&& f) {
   if (h.busy) throw std::runtime_error("this scene is rendering in another thread; edit it afterwards");
@@ -151,15 +153,23 @@ NB_MODULE(_ember, m) {
           "spp"_a.none(), "seed"_a.none(), "threads"_a, "first_sample"_a, "strategy"_a.none(), "aovs"_a,
           "progress"_a.none(), "pass_spp"_a)
       .def("set_camera",
-           [](SceneHandle& h, nb::dict patch) { edit(h, [&] { h.setCamera(toJson(patch, "camera")); }); })
+           [](SceneHandle& h, nb::dict patch) {
+             const nlohmann::json p = toJson(patch, "camera");
+             edit(h, [&] { h.setCamera(p); });
+           })
       .def("set_material",
            [](SceneHandle& h, const std::string& name, nb::dict patch) {
-             edit(h, [&] { h.setMaterial(name, toJson(patch, "materials." + name)); });
+             const nlohmann::json p = toJson(patch, "materials." + name);
+             edit(h, [&] { h.setMaterial(name, p); });
            })
-      .def("set_shape", [](SceneHandle& h, SceneHandle::Key key,
-                           nb::dict patch) { edit(h, [&] { h.setShape(key, toJson(patch, "shapes")); }); })
+      .def("set_shape",
+           [](SceneHandle& h, SceneHandle::Key key, nb::dict patch) {
+             const nlohmann::json p = toJson(patch, "shapes");
+             edit(h, [&] { h.setShape(key, p); });
+           })
       .def("set_light", [](SceneHandle& h, SceneHandle::Key key, nb::dict patch) {
-        edit(h, [&] { h.setLight(key, toJson(patch, "lights")); });
+        const nlohmann::json p = toJson(patch, "lights");
+        edit(h, [&] { h.setLight(key, p); });
       });
 
   m.def("load_file", &loadFile, "path"_a, "camera"_a, "variant"_a);

@@ -54,8 +54,10 @@ nb::tuple renderScene(SceneHandle& handle, const RenderRequest& request) {
     if (!parsed) throw nb::value_error(("aovs: " + error).c_str());
     aovs = *parsed;
   }
-  if (scene.uvOnEveryHit != aovs.has(Aov::Uv) && aovs.has(Aov::Uv)) {
-    scene.uvOnEveryHit = true;  // every hit then works out its uv: a rebuild where shapes skipped it
+  if (aovs.has(Aov::Uv) && !scene.uvOnEveryHit) {
+    // Every hit then works out its uv (a rebuild where shapes skipped it), from now on: switching
+    // back would rebuild again at the next render that asks for uv.
+    scene.uvOnEveryHit = true;
     scene.update();
   }
   RenderOptions options;
@@ -83,7 +85,22 @@ nb::tuple renderScene(SceneHandle& handle, const RenderRequest& request) {
   std::optional<nb::python_error> raised;  // Ctrl-C, or the progress callback's exception
 
   handle.busy = true;
-  std::thread worker([&] {
+  std::thread worker;
+  // However this call ends, the render is stopped and joined and the scene freed for edits.
+  struct Finally {
+    SceneHandle& handle;
+    std::atomic<bool>& stop;
+    std::thread& worker;
+    ~Finally() {
+      stop = true;
+      if (worker.joinable()) {
+        nb::gil_scoped_release release;
+        worker.join();
+      }
+      handle.busy = false;
+    }
+  } finally{handle, stop, worker};
+  worker = std::thread([&] {
     try {
       stats = render(scene, *integrator, options, film);
     } catch (...) {
@@ -119,13 +136,17 @@ nb::tuple renderScene(SceneHandle& handle, const RenderRequest& request) {
       }
     }
   }
-  worker.join();
-  handle.busy = false;
+  {
+    nb::gil_scoped_release release;
+    worker.join();
+  }
   if (failure) std::rethrow_exception(failure);
   const bool interrupted = raised && raised->matches(PyExc_KeyboardInterrupt);
   if (raised && !interrupted) throw std::move(*raised);
-  if (const std::string error = filteredTextureFailure(); !error.empty()) throw InputError(error);
-  if (!interrupted && !request.progress.is_none()) request.progress(stats.sppDone, total);
+  if (const std::string error = takeFilteredTextureFailure(); !error.empty()) throw InputError(error);
+  if (!interrupted && !request.progress.is_none() &&
+      std::min(total, reported * options.passSpp) != stats.sppDone)
+    request.progress(stats.sppDone, total);
 
   nb::dict aovArrays;
   for (ImageLayer& layer : film.aovLayers()) {

@@ -3,8 +3,6 @@
 #include "io/input_error.h"
 #include "io/json_reader.h"
 
-#include <glm/gtc/matrix_inverse.hpp>
-
 #include <filesystem>
 
 namespace ember::python {
@@ -146,8 +144,10 @@ void SceneHandle::setMaterial(const std::string& name, const nlohmann::json& pat
         name_ + ": materials." + name +
         ": a glTF material is replaced by a whole material of the JSON format: give its \"type\" "
         "(docs/scene-format.md)");
-  scene_->replaceMaterial(size_t(it - names.begin()),
-                          JsonEntryReader(*scene_, name_).material(material, name));
+  JsonEntryReader reader(*scene_, name_);
+  std::unique_ptr<Material> replacement = reader.material(material, name);
+  reader.adoptInto(*scene_);
+  scene_->replaceMaterial(size_t(it - names.begin()), std::move(replacement));
   document_["materials"][name] = material;
 }
 
@@ -158,7 +158,7 @@ void SceneHandle::setShape(const Key& key, const nlohmann::json& patch) {
   const nlohmann::json& old = document_["shapes"][k];
   const nlohmann::json shape = merged(retyped(old, patch, shadingKey), patch);
   const JsonSceneIndex::Range& range = index_.shapes[k];
-  const JsonEntryReader reader(*scene_, name_);
+  JsonEntryReader reader(*scene_, name_);
   if (range.mesh) {
     // A mesh entry moves as a whole: every glTF primitive it placed, where each is an instance.
     for (const auto& [key, value] : patch.items())
@@ -166,24 +166,23 @@ void SceneHandle::setShape(const Key& key, const nlohmann::json& patch) {
         throw InputError(name_ + ": " + path + "." + key +
                          ": only a mesh entry's transform can change without loading the scene again");
     const nlohmann::json identity = nlohmann::json::object();
-    const Mat4 before = reader.transform(old.value("transform", identity), path + ".transform");
     const Mat4 after = reader.transform(shape.value("transform", identity), path + ".transform");
     for (size_t i = range.first; i < range.first + range.count; ++i)
-      if (!scene_->meshes[i].toWorld)
+      if (!scene_->meshes[i].toWorld || !scene_->meshes[i].inFile)
         throw InputError(name_ + ": " + path +
                          ".transform: this file's meshes were placed in world space when loaded (each is "
                          "used once), so moving them means loading the scene again; meshes used by several "
                          "nodes are instances and move without a reload");
-    const Mat4 change = after * glm::inverse(before);
     std::vector<std::pair<size_t, Mat4>> placements;
     for (size_t i = range.first; i < range.first + range.count; ++i) {
-      placements.push_back({i, change * *scene_->meshes[i].toWorld});
+      placements.push_back({i, after * *scene_->meshes[i].inFile});
       if (!MeshInstance::placeable(placements.back().second))
         throw InputError(name_ + ": " + path + ".transform: not invertible, or not finite once composed");
     }
     scene_->setMeshTransforms(placements);
   } else {
     Scene::ShapeEntry entry = reader.shape(shape, path);
+    reader.adoptInto(*scene_);
     bool moved = false;
     for (const auto& [key, value] : patch.items()) moved = moved || !shadingKey(key);
     Scene::ShapeEntry& current = scene_->shapes[range.first];

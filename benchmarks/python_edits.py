@@ -1,0 +1,140 @@
+"""The Python module's costs: `import ember` to the first image, and an edit then a render against
+loading the scene again then the same render (issue 47).
+
+    .venv/bin/python benchmarks/python_edits.py [--repeats 7] [--gltf FILE ...]
+
+Each cell is the median of --repeats runs in this process (scenes loaded before timing, so file
+caches are warm for both sides); the first-image time is one fresh interpreter per run."""
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+
+import ember
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SCENES = os.path.join(ROOT, "scenes")
+
+FIRST_IMAGE = """
+import time
+t0 = time.perf_counter()
+import ember
+t1 = time.perf_counter()
+scene = ember.load({scene!r})
+t2 = time.perf_counter()
+scene.render(spp=1)
+t3 = time.perf_counter()
+print(t1 - t0, t2 - t1, t3 - t2)
+"""
+
+
+def median_seconds(run, repeats):
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        run()
+        times.append(time.perf_counter() - start)
+    return statistics.median(times)
+
+
+def first_image(scene, repeats):
+    rows = []
+    for _ in range(repeats):
+        out = subprocess.run([sys.executable, "-c", FIRST_IMAGE.format(scene=scene)], capture_output=True,
+                             text=True, check=True).stdout
+        rows.append([float(x) for x in out.split()])
+    return [statistics.median(col) for col in zip(*rows)]
+
+
+def edits_of(path):
+    """(name, edit) pairs that apply to the scene at path, each undone by the next call's values."""
+    flip = {"n": 0}
+
+    def toggled(a, b):
+        flip["n"] += 1
+        return a if flip["n"] % 2 else b
+
+    scene = ember.load(path)
+    doc = scene.document if scene._handle.is_json else None
+    camera = scene.info()["camera"]
+    edits = [("camera", lambda s: s.set_camera(fov=toggled(camera.get("fov_y_deg", 40) * 0.9,
+                                                            camera.get("fov_y_deg", 40))))]
+    if doc is None:  # a glTF file: its first material becomes a JSON diffuse one
+        name = scene.info()["materials"][0]["name"]
+        edits.append(("material", lambda s: s.set_material(name, type="diffuse",
+                                                            reflectance=toggled(0.3, 0.6))))
+        return edits
+    name, material = next(iter(doc["materials"].items()))
+    if material["type"] in ("diffuse", "lambertian"):
+        edits.append(("material", lambda s: s.set_material(name, reflectance=toggled(0.3, 0.6))))
+    for i, shape in enumerate(doc["shapes"]):
+        if shape["type"] == "sphere":
+            c = shape["center"]
+            edits.append(("move a sphere", lambda s, i=i, c=c: s.set_shape(
+                i, center=[c[0], toggled(c[1] + 0.1, c[1]), c[2]])))
+            break
+    for i, shape in enumerate(doc["shapes"]):
+        if shape.get("emission"):
+            e = shape["emission"]
+            edits.append(("emission", lambda s, i=i, e=e: s.set_shape(i, emission=toggled(
+                [0.5 * x for x in e] if isinstance(e, list) else 0.5 * e, e))))
+            break
+    for i, shape in enumerate(doc["shapes"]):
+        if shape["type"] == "mesh" and "transform" in shape:
+            t = dict(shape["transform"])
+            moved = dict(t, translate=[x + 0.1 for x in t.get("translate", [0, 0, 0])])
+            try:
+                scene.set_shape(i, transform=moved)
+                scene.set_shape(i, transform=t)
+            except ember.SceneError:
+                continue  # baked into world space: not an edit the module makes
+            edits.append(("move instanced meshes", lambda s, i=i: s.set_shape(i, transform=toggled(moved, t))))
+            break
+    if doc.get("lights"):
+        light = doc["lights"][0]
+        key = "irradiance" if light["type"] == "directional" else "intensity"
+        v = light[key]
+        edits.append(("light", lambda s: s.set_light(0, **{key: toggled(v * 0.5 if not isinstance(v, list)
+                                                                          else [x * 0.5 for x in v], v)})))
+    return edits
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--repeats", type=int, default=7)
+    parser.add_argument("--gltf", nargs="*", default=[])
+    parser.add_argument("--json", help="also write the results here")
+    args = parser.parse_args()
+    results = {"first_image": {}, "edits": []}
+
+    cornell = os.path.join(SCENES, "cornell-area.json")
+    imp, load, render = first_image(cornell, args.repeats)
+    results["first_image"] = {"scene": "cornell-area", "import": imp, "load": load, "render_1spp": render}
+    print(f"first image (cornell-area 256x256, 1 spp): import {imp:.3f} s, load+build {load:.3f} s, "
+          f"render {render:.3f} s, total {imp + load + render:.3f} s")
+
+    print(f"\n{'scene':<22} {'edit':<22} {'edit s':>9} {'reload s':>9} {'ratio':>7} "
+          f"{'edit+1spp s':>12} {'reload+1spp s':>14}")
+    paths = [os.path.join(SCENES, s) for s in ("cornell-area.json", "cornell-point.json", "gltf-mixed.json")]
+    for path in paths + args.gltf:
+        scene = ember.load(path)
+        reload_s = median_seconds(lambda: ember.load(path), args.repeats)
+        reload_render = median_seconds(lambda: ember.load(path).render(spp=1), args.repeats)
+        for name, edit in edits_of(path):
+            edit_s = median_seconds(lambda: edit(scene), args.repeats)
+            edit_render = median_seconds(lambda: (edit(scene), scene.render(spp=1)), args.repeats)
+            label = os.path.basename(path)
+            print(f"{label:<22} {name:<22} {edit_s:9.4f} {reload_s:9.4f} {reload_s / edit_s:6.0f}x "
+                  f"{edit_render:12.4f} {reload_render:14.4f}")
+            results["edits"].append({"scene": label, "edit": name, "edit_s": edit_s, "reload_s": reload_s,
+                                     "edit_render_1spp_s": edit_render, "reload_render_1spp_s": reload_render})
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(results, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()
