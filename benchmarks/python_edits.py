@@ -1,34 +1,20 @@
-"""The Python module's costs: `import ember` to the first image, and an edit then a render against
-loading the scene again then the same render (issue 47).
+"""The Python module's edits: an edit, then a render, against loading the scene again, then the same
+render (issue 47). `import ember` to the first image: benchmarks/python_vs_mitsuba.py.
 
     .venv/bin/python benchmarks/python_edits.py [--repeats 7] [--gltf FILE ...]
 
 Each cell is the median of --repeats runs in this process (scenes loaded before timing, so file
-caches are warm for both sides); the first-image time is one fresh interpreter per run."""
+caches are warm for both sides)."""
 import argparse
 import json
 import os
 import statistics
-import subprocess
-import sys
 import time
 
 import ember
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENES = os.path.join(ROOT, "scenes")
-
-FIRST_IMAGE = """
-import time
-t0 = time.perf_counter()
-import ember
-t1 = time.perf_counter()
-scene = ember.load({scene!r})
-t2 = time.perf_counter()
-scene.render(spp=1)
-t3 = time.perf_counter()
-print(t1 - t0, t2 - t1, t3 - t2)
-"""
 
 
 def median_seconds(run, repeats):
@@ -38,15 +24,6 @@ def median_seconds(run, repeats):
         run()
         times.append(time.perf_counter() - start)
     return statistics.median(times)
-
-
-def first_image(scene, repeats):
-    rows = []
-    for _ in range(repeats):
-        out = subprocess.run([sys.executable, "-c", FIRST_IMAGE.format(scene=scene)], capture_output=True,
-                             text=True, check=True).stdout
-        rows.append([float(x) for x in out.split()])
-    return [statistics.median(col) for col in zip(*rows)]
 
 
 def edits_of(path):
@@ -108,16 +85,10 @@ def main():
     parser.add_argument("--gltf", nargs="*", default=[])
     parser.add_argument("--json", help="also write the results here")
     args = parser.parse_args()
-    results = {"first_image": {}, "edits": []}
+    results = {"edits": []}
 
-    cornell = os.path.join(SCENES, "cornell-area.json")
-    imp, load, render = first_image(cornell, args.repeats)
-    results["first_image"] = {"scene": "cornell-area", "import": imp, "load": load, "render_1spp": render}
-    print(f"first image (cornell-area 256x256, 1 spp): import {imp:.3f} s, load+build {load:.3f} s, "
-          f"render {render:.3f} s, total {imp + load + render:.3f} s")
-
-    print(f"\n{'scene':<22} {'edit':<22} {'edit s':>9} {'reload s':>9} {'ratio':>7} "
-          f"{'edit+1spp s':>12} {'reload+1spp s':>14}")
+    print(f"\n{'scene':<22} {'edit':<22} {'edit ms':>9} {'reload ms':>10} {'ratio':>7} "
+          f"{'edit+1spp ms':>13} {'reload+1spp ms':>15}")
     paths = [os.path.join(SCENES, s) for s in ("cornell-area.json", "cornell-point.json", "gltf-mixed.json")]
     for path in paths + args.gltf:
         scene = ember.load(path)
@@ -127,8 +98,8 @@ def main():
             edit_s = median_seconds(lambda: edit(scene), args.repeats)
             edit_render = median_seconds(lambda: (edit(scene), scene.render(spp=1)), args.repeats)
             label = os.path.basename(path)
-            print(f"{label:<22} {name:<22} {edit_s:9.4f} {reload_s:9.4f} {reload_s / edit_s:6.0f}x "
-                  f"{edit_render:12.4f} {reload_render:14.4f}")
+            print(f"{label:<22} {name:<22} {1e3 * edit_s:9.3f} {1e3 * reload_s:10.3f} {reload_s / edit_s:6.0f}x "
+                  f"{1e3 * edit_render:13.1f} {1e3 * reload_render:15.1f}")
             results["edits"].append({"scene": label, "edit": name, "edit_s": edit_s, "reload_s": reload_s,
                                      "edit_render_1spp_s": edit_render, "reload_render_1spp_s": reload_render})
     if args.json:
