@@ -45,7 +45,7 @@ for target in scene_json gltf checkpoint image; do
   echo "fuzz_$target: ${seconds}s from $(ls "$corpus/$target" | wc -l) seeds"
   # fast_unwind_on_malloc=0: full allocation stacks through libstdc++, which scripts/lsan-suppressions.txt
   # needs to tell OpenImageIO's own leak apart.
-  if ! ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:fast_unwind_on_malloc=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+  if ! ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:fast_unwind_on_malloc=0:intercept_tls_get_addr=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
       LSAN_OPTIONS=suppressions="$PWD/scripts/lsan-suppressions.txt" \
       "build-fuzz/fuzz/fuzz_$target" "$corpus/$target" -max_total_time="$seconds" -timeout=20 \
       -rss_limit_mb=4096 -print_final_stats=1 -artifact_prefix="build-fuzz/crash-$target-" \

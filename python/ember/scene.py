@@ -112,6 +112,12 @@ class Scene:
         e.g. ``set_light(0, intensity=[50, 50, 50])``. The BVHs are kept."""
         self._handle.set_light(key, params)
 
+    def set_background(self, radiance: Union[float, Sequence[float]]) -> None:
+        """The environment: a constant radiance (one number or r, g, b; 0 for none), replacing any
+        environment map, as ``render.background`` in a JSON scene or ``ember render --env r,g,b``
+        (a glTF file's default is white, 1). The BVHs are kept."""
+        self._handle.set_background(radiance)
+
     def __repr__(self) -> str:
         return f"<ember.Scene {self._handle.name!r} {self.width}x{self.height}>"
 

@@ -167,6 +167,11 @@ NB_MODULE(_ember, m) {
              const nlohmann::json p = toJson(patch, "shapes");
              edit(h, [&] { h.setShape(key, p); });
            })
+      .def("set_background",
+           [](SceneHandle& h, nb::handle value) {
+             const nlohmann::json v = toJson(value, "render.background");
+             edit(h, [&] { h.setBackground(v); });
+           })
       .def("set_light", [](SceneHandle& h, SceneHandle::Key key, nb::dict patch) {
         const nlohmann::json p = toJson(patch, "lights");
         edit(h, [&] { h.setLight(key, p); });

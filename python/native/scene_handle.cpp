@@ -210,4 +210,14 @@ void SceneHandle::setLight(const Key& key, const nlohmann::json& patch) {
   document_["lights"][k] = light;
 }
 
+void SceneHandle::setBackground(const nlohmann::json& value) {
+  const Color background = JsonNode(value, "render.background", name_).color();
+  scene_->background = background;
+  scene_->environmentMap = nullptr;
+  scene_->update();
+  if (!json_) return;
+  document_["render"]["background"] = value;
+  document_.erase("environment");  // the format takes one or the other
+}
+
 }  // namespace ember::python

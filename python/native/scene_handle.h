@@ -34,6 +34,9 @@ class SceneHandle {
   void setMaterial(const std::string& name, const nlohmann::json& patch);
   void setShape(const Key& key, const nlohmann::json& patch);
   void setLight(const Key& key, const nlohmann::json& patch);
+  // The constant environment radiance (render.background: a number or r, g, b; 0 = none); it
+  // replaces an environment map.
+  void setBackground(const nlohmann::json& value);
 
   // Set while a render runs without the GIL: edits and other renders are refused meanwhile.
   bool busy = false;

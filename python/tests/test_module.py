@@ -176,7 +176,8 @@ def reloaded(scene, spp=4):
     lambda s: s.set_shape("light", emission=[4, 4, 4]),
     lambda s: s.set_shape("light", emission=None, material="white"),  # the only light goes out
     lambda s: s.set_shape(7, type="box", center=[0.4, 0.3, 0.3], size=[0.4, 0.6, 0.4], radius=None),
-], ids=["camera", "ior", "material-type", "move-sphere", "emission", "light-off", "sphere-to-box"])
+    lambda s: s.set_background([0.1, 0.2, 0.3]),
+], ids=["camera", "ior", "material-type", "move-sphere", "emission", "light-off", "sphere-to-box", "background"])
 def test_an_edit_renders_what_loading_the_edited_scene_renders(edit):
     scene = ember.load(small(), base_dir=SCENES)
     before = scene.render(spp=4)
@@ -192,6 +193,20 @@ def test_light_edits_on_a_point_light_scene():
     scene.set_light("point", intensity=[8, 8, 8])
     assert np.array_equal(scene.render(spp=4), reloaded(scene))
     assert not np.array_equal(scene.render(spp=4), base)
+
+
+def test_the_background_of_a_gltf_file_as_ember_render_env_sets_it(tmp_path):
+    gltf = os.path.join(SCENES, "gltf", "sphere-grid.gltf")
+    out = tmp_path / "cli.exr"
+    subprocess.run([EMBER, "render", gltf, "-o", str(out), "--spp", "2", "--env", "0.2,0.3,0.5", "-q"],
+                   check=True, capture_output=True)
+    scene = ember.load(gltf)
+    white = scene.render(spp=2)
+    scene.set_background([0.2, 0.3, 0.5])
+    assert np.array_equal(scene.render(spp=2), openexr_rgb(out))
+    assert not np.array_equal(scene.render(spp=2), white)
+    with pytest.raises(ember.SceneError, match="render.background"):
+        scene.set_background(-1)
 
 
 def test_moving_an_instanced_mesh_entry_matches_a_reload():
