@@ -48,7 +48,7 @@ Runner addInfoCommand(CLI::App& app) {
                 static_cast<unsigned long long>(image["seed"].get<uint64_t>()));
     std::printf("camera:     origin %s target %s ", vec(camera["origin"]).c_str(),
                 vec(camera["target"]).c_str());
-    if (camera["projection"] == "orthographic")
+    if (camera.value("type", "pinhole") == "orthographic")
       std::printf("orthographic, half height %g\n", camera["half_height"].get<double>());
     else
       std::printf("fov_y %g deg\n", camera["fov_y_deg"].get<double>());

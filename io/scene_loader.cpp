@@ -638,6 +638,18 @@ void JsonEntryReader::adoptInto(Scene& scene) {
   loader_ = std::make_unique<JsonSceneLoader>(file_, *scratch_, nullptr, &scene);
 }
 
+nlohmann::json cameraJson(const CameraParams& c) {
+  const auto vec = [](const Vec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); };
+  nlohmann::json j = {{"origin", vec(c.origin)}, {"target", vec(c.target)}, {"up", vec(c.up)}};
+  if (c.projection == Projection::Orthographic) {
+    j["type"] = "orthographic";
+    j["half_height"] = c.orthoHalfHeight;
+  } else {
+    j["fov_y_deg"] = c.fovYDeg;
+  }
+  return j;
+}
+
 CameraParams JsonEntryReader::camera(const nlohmann::json& value) const {
   return loader_->readCameraParams(JsonNode(value, "camera", file_));
 }

@@ -34,6 +34,10 @@ Scene loadJsonScene(const std::string& path, JsonSceneIndex* index = nullptr);
 // messages, and its folder (none: the working directory) resolves the relative paths inside.
 Scene loadJsonScene(const nlohmann::json& document, const std::string& name, JsonSceneIndex* index = nullptr);
 
+// A camera as the JSON format writes it ("camera": origin, target, up, fov_y_deg, or type
+// "orthographic" and half_height): what JsonEntryReader::camera reads back.
+nlohmann::json cameraJson(const CameraParams& camera);
+
 class JsonSceneLoader;
 
 // Single entries of a JSON scene read again, with the loader's checks and error messages (naming

@@ -1,5 +1,7 @@
 #include "io/scene_summary.h"
 
+#include "io/scene_loader.h"
+
 namespace ember {
 
 nlohmann::json sceneSummary(const Scene& scene) {
@@ -21,14 +23,6 @@ nlohmann::json sceneSummary(const Scene& scene) {
   }
   const RenderSettings& rs = scene.settings;
   const CameraParams& c = scene.cameraParams;
-  json camera = {{"origin", vec(c.origin)}, {"target", vec(c.target)}, {"up", vec(c.up)}};
-  if (c.projection == Projection::Orthographic) {
-    camera["projection"] = "orthographic";
-    camera["half_height"] = c.orthoHalfHeight;
-  } else {
-    camera["projection"] = "pinhole";
-    camera["fov_y_deg"] = c.fovYDeg;
-  }
   const CausticTracer& tracer = scene.causticTracer();
   json caustics = {{"traced", rs.traceCaustics && tracer.enabled()}};
   if (!rs.traceCaustics)
@@ -50,7 +44,7 @@ nlohmann::json sceneSummary(const Scene& scene) {
         {"max_depth", rs.maxDepth},
         {"rr_depth", rs.rrDepth},
         {"seed", rs.seed}}},
-      {"camera", camera},
+      {"camera", cameraJson(c)},
       {"shapes", shapes},
       {"meshes", scene.meshes.size()},
       {"triangles", scene.triangleCount()},

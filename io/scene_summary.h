@@ -8,8 +8,8 @@
 
 namespace ember {
 
-// Keys: image {width, height, spp, max_depth, rr_depth, seed}, camera {origin, target, up,
-// projection, fov_y_deg | half_height}, shapes {type: count}, meshes, triangles, unique_triangles,
+// Keys: image {width, height, spp, max_depth, rr_depth, seed}, camera (as the JSON format
+// writes it: cameraJson), shapes {type: count}, meshes, triangles, unique_triangles,
 // lights {punctual, area, area_two_sided, emissive_triangles, emissive_triangles_two_sided,
 // environment}, strategy, caustics {traced, casters | why_not}, materials [{name, type}],
 // variants [names], bounds [[lower], [upper]].

@@ -100,8 +100,8 @@ class Scene {
   // on what changed, with the same result as build() from scratch:
   // - update(), after editing cameraParams, settings, materials or the entries' material pointers,
   //   emissions, `lights`' loaded entries (lights added after build() need build()), background
-  //   or environment: the lights, records, light
-  //   sampler, camera and caustic tracer are derived again, the BVHs kept. Where an edit changes
+  //   or environment: the lights, records, light sampler, camera and caustic tracer are derived
+  //   again, the BVHs kept. Where an edit changes
   //   what the acceleration structure holds (a shape's ray-mask bit moves when a flat shape starts
   //   or stops emitting, a material starts reading texture coordinates, an instanced mesh starts
   //   emitting and must be baked into world space) it builds everything.

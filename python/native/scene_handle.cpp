@@ -20,18 +20,6 @@ nlohmann::json merged(nlohmann::json base, const nlohmann::json& patch) {
   return base;
 }
 
-nlohmann::json cameraJson(const CameraParams& c) {
-  const auto vec = [](const Vec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); };
-  nlohmann::json j = {{"origin", vec(c.origin)}, {"target", vec(c.target)}, {"up", vec(c.up)}};
-  if (c.projection == Projection::Orthographic) {
-    j["type"] = "orthographic";
-    j["half_height"] = c.orthoHalfHeight;
-  } else {
-    j["fov_y_deg"] = c.fovYDeg;
-  }
-  return j;
-}
-
 // An entry whose "type" the patch changes keeps none of its old type's keys, only those `kept`
 // says belong to every type.
 template <class Kept>
@@ -89,7 +77,8 @@ void SceneHandle::requireJson(const char* what) const {
 }
 
 size_t SceneHandle::entryIndex(const Key& key, const char* array) const {
-  const nlohmann::json& entries = document_.contains(array) ? document_.at(array) : nlohmann::json::array();
+  static const nlohmann::json none = nlohmann::json::array();
+  const nlohmann::json& entries = document_.contains(array) ? document_.at(array) : none;
   if (const auto* index = std::get_if<int64_t>(&key)) {
     const int64_t n = int64_t(entries.size());
     if (*index < -n || *index >= n)
